@@ -1,0 +1,123 @@
+#include "slavesim/al_state_machine.hpp"
+
+namespace ecsim::slavesim {
+namespace {
+
+std::uint16_t code(AlStatusCode c) {
+  return static_cast<std::uint16_t>(c);
+}
+
+int rank(AlState s) {
+  switch (s) {
+    case AlState::kInit:
+      return 0;
+    case AlState::kPreOp:
+      return 1;
+    case AlState::kSafeOp:
+      return 2;
+    case AlState::kOp:
+      return 3;
+    case AlState::kBootstrap:
+      return -1;
+  }
+  return -1;
+}
+
+}  // namespace
+
+std::uint16_t AlStateMachine::checkMailbox(const Esc& esc, const SlaveProfile::Mailbox& mbx) const {
+  // SM0 must be a mailbox the master writes, SM1 one it reads, at the SII's offsets and no
+  // larger than the SII's sizes (what slave stacks check at INIT->PREOP).
+  auto out = esc.smConfig(0);
+  auto in = esc.smConfig(1);
+  auto ok = [](const Esc::SmConfig& c, std::uint16_t start, std::uint16_t size, bool write) {
+    return c.enabled && (c.control & reg::sm::kControlModeMask) == reg::sm::kControlModeMailbox &&
+           ((c.control & reg::sm::kControlDirectionMask) == reg::sm::kControlDirectionWrite) ==
+               write &&
+           c.start == start && c.length >= 8 && c.length <= size;
+  };
+  if (!ok(out, mbx.outStart, mbx.outSize, true) || !ok(in, mbx.inStart, mbx.inSize, false)) {
+    return code(AlStatusCode::kInvalidMailboxConfigurationPreOp);
+  }
+  return 0;
+}
+
+std::uint16_t AlStateMachine::checkProcessData(const Esc& esc, const SlaveProfile& profile) const {
+  for (const auto& pd : profile.processData) {
+    if (pd.length == 0) continue;
+    auto c = esc.smConfig(pd.index);
+    const bool write =
+        (c.control & reg::sm::kControlDirectionMask) == reg::sm::kControlDirectionWrite;
+    const bool buffered = (c.control & reg::sm::kControlModeMask) == reg::sm::kControlModeBuffered;
+    if (!c.enabled || !buffered || write != pd.outputs || c.length != pd.length) {
+      return code(pd.outputs ? AlStatusCode::kInvalidOutputConfiguration
+                             : AlStatusCode::kInvalidInputConfiguration);
+    }
+  }
+  return 0;
+}
+
+void AlStateMachine::raiseError(Esc& esc, AlState target, std::uint16_t statusCode) {
+  AlState current = state(esc);
+  AlState next = rank(target) >= 0 && rank(target) < rank(current) ? target : current;
+  esc.pdiSetAlStatus(static_cast<std::uint16_t>(static_cast<std::uint16_t>(next) | kAlErrorFlag),
+                     statusCode);
+}
+
+void AlStateMachine::onAlControl(Esc& esc, const SlaveProfile& profile) {
+  const std::uint16_t control = esc.alControl();
+  const bool ack = (control & kAlErrorFlag) != 0;
+  const std::uint16_t status = esc.alStatus();
+  const AlState current = state(esc);
+  const bool errorPending = (status & kAlErrorFlag) != 0;
+  // With an error indicated, requests without acknowledge leave state and error as they are
+  // (ETG.1000.6 §6.4.1.4: the master must acknowledge with AL control bit 4).
+  if (errorPending && !ack) return;
+  std::uint16_t errorCode = 0;
+  AlState next = current;
+  auto requested = alStateFromRaw(control & kAlStateMask);
+  if (!requested) {
+    errorCode = code(AlStatusCode::kUnknownRequestedState);
+  } else if (*requested == current) {
+    next = current;
+  } else if (*requested == AlState::kBootstrap) {
+    if (current != AlState::kInit) {
+      errorCode = code(AlStatusCode::kInvalidRequestedStateChange);
+    } else if (!profile.bootstrapMailbox) {
+      errorCode = code(AlStatusCode::kBootstrapNotSupported);
+    } else {
+      next = AlState::kBootstrap;
+    }
+  } else if (current == AlState::kBootstrap) {
+    if (*requested == AlState::kInit) {
+      next = AlState::kInit;
+    } else {
+      errorCode = code(AlStatusCode::kInvalidRequestedStateChange);
+    }
+  } else if (rank(*requested) < rank(current)) {
+    next = *requested;  // every downward transition is allowed
+  } else if (rank(*requested) != rank(current) + 1) {
+    errorCode = code(AlStatusCode::kInvalidRequestedStateChange);  // I->S, I->O, P->O
+  } else if (*requested == AlState::kPreOp) {
+    if (profile.mailbox) errorCode = checkMailbox(esc, *profile.mailbox);
+    if (errorCode == 0) next = AlState::kPreOp;
+  } else if (*requested == AlState::kSafeOp) {
+    errorCode = checkProcessData(esc, profile);
+    if (errorCode == 0) next = AlState::kSafeOp;
+  } else {  // SAFEOP -> OP: the master must have delivered valid outputs first
+    for (const auto& pd : profile.processData) {
+      if (pd.outputs && pd.length > 0 && !esc.pdiOutputsReceived(pd.index)) {
+        errorCode = code(AlStatusCode::kNoValidOutputs);
+      }
+    }
+    if (errorCode == 0) next = AlState::kOp;
+  }
+  if (errorCode != 0) {
+    esc.pdiSetAlStatus(
+        static_cast<std::uint16_t>(static_cast<std::uint16_t>(current) | kAlErrorFlag), errorCode);
+  } else {
+    esc.pdiSetAlStatus(static_cast<std::uint16_t>(next), 0);
+  }
+}
+
+}  // namespace ecsim::slavesim

@@ -1,0 +1,52 @@
+// The EtherCAT state machine (ESM) as slave firmware runs it (ETG.1000.6 §6.4, ESC datasheet
+// section I §10): it reacts to AL control writes, checks the SyncManager configuration a
+// master made against what the device needs, and reports refusals with an AL status code.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "protocol/al_status.hpp"
+#include "slavesim/esc.hpp"
+
+namespace ecsim::slavesim {
+
+// What the firmware expects of the master's configuration.
+struct SlaveProfile {
+  struct Mailbox {
+    std::uint16_t outStart{0};  // master -> slave (SM0)
+    std::uint16_t outSize{0};
+    std::uint16_t inStart{0};  // slave -> master (SM1)
+    std::uint16_t inSize{0};
+  };
+  std::optional<Mailbox> mailbox;           // standard mailbox, if the device has one
+  std::optional<Mailbox> bootstrapMailbox;  // BOOT state supported when present
+  struct ProcessDataSm {
+    unsigned index{2};
+    bool outputs{true};       // ECAT write direction
+    std::uint16_t length{0};  // expected byte length for the active PDO assignment
+  };
+  std::vector<ProcessDataSm> processData;
+};
+
+class AlStateMachine {
+ public:
+  // Handles a pending AL control write. `profile` gives the current expectations (PDO
+  // assignment may change in PREOP, so the caller passes the up-to-date profile).
+  void onAlControl(Esc& esc, const SlaveProfile& profile);
+
+  // Local error raised by the firmware (SM watchdog, sync error...): drops to `state` with
+  // the error flag and the code, as ETG.1000.6 Table 11 prescribes.
+  void raiseError(Esc& esc, AlState state, std::uint16_t code);
+
+  static AlState state(const Esc& esc) {
+    return static_cast<AlState>(esc.alStatus() & reg::al::kStateMask);
+  }
+
+ private:
+  std::uint16_t checkMailbox(const Esc& esc, const SlaveProfile::Mailbox& mbx) const;
+  std::uint16_t checkProcessData(const Esc& esc, const SlaveProfile& profile) const;
+};
+
+}  // namespace ecsim::slavesim

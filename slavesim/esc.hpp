@@ -1,0 +1,202 @@
+// A simulated EtherCAT Slave Controller: the register file and process RAM, datagram
+// processing with the working-counter rules, FMMUs, SyncManagers (mailbox and 3-buffer), the
+// SII EEPROM interface, error counters and the DC registers the ECAT side sees.
+//
+// The ESC is driven from two sides, as the hardware is:
+//  - the ECAT side: processDatagram() for each datagram of a frame passing through (called by
+//    topology/Segment, which knows the addressing position and timing);
+//  - the PDI side: the slave's firmware (ESM, mailbox server, device model) reads outputs,
+//    writes inputs, serves the mailbox and sets AL status through the pdi*() functions.
+// It never allocates after construction and never reads a clock: times are passed in.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "protocol/bytes.hpp"
+#include "protocol/frame.hpp"
+#include "protocol/registers.hpp"
+#include "protocol/time.hpp"
+#include "slavesim/esc_type.hpp"
+
+namespace ecsim::slavesim {
+
+struct EscCounters {
+  std::uint64_t datagramsAddressed{0};
+  std::uint64_t framesSeen{0};
+  std::uint64_t mailboxWrites{0};
+  std::uint64_t mailboxWritesRejected{0};
+  std::uint64_t outOfRangeAccesses{0};
+};
+
+// What the ECAT side did that the firmware must react to, collected while a frame passes and
+// handed over with takeEvents() after it (the firmware runs "between frames", as on hardware).
+struct EscEvents {
+  bool alControlWritten{false};
+  bool mailboxReceived{false};  // SM0-type mailbox became full
+  bool mailboxRead{false};      // SM1-type mailbox was emptied by the master
+  bool smConfigChanged{false};
+  bool outputsWritten{false};  // a buffered write SM completed a buffer
+  bool eepromReloaded{false};
+  bool dcLatched{false};
+  bool dlControlWritten{false};  // port loop settings may have changed
+};
+
+class Esc {
+ public:
+  Esc(const EscType& type, std::vector<std::uint8_t> siiImage);
+
+  const EscType& type() const { return type_; }
+
+  // ---- ECAT side ------------------------------------------------------------------------
+  // Processes one datagram at this ESC. localTime is the ESC's local clock when the datagram's
+  // first byte passes the processing unit. Modifies data, ADP and WKC in place.
+  void processDatagram(DatagramView datagram, SimTime localTime);
+  // Working counter increment this ESC gave the last processed datagram (for tests/tracing).
+  std::uint16_t lastWkcIncrement() const { return lastWkcIncrement_; }
+  // A new frame starts passing (resets per-frame state such as the ARMW reference).
+  void beginFrame() { ++counters_.framesSeen; }
+
+  // DC: a write to 0x0900 arms the receive-time latch; when the frame has passed, the topology
+  // hands over the local times its first bit arrived at each port (mask: ports it arrived at)
+  // and they are stored in 0x0900-0x090F.
+  bool receiveTimeLatchArmed() const { return latchArmed_; }
+  void completeReceiveTimeLatch(const std::array<SimTime, 4>& localTimes, std::uint8_t portMask);
+
+  // ---- PDI side (firmware) --------------------------------------------------------------
+  std::uint16_t alControl() const { return reg16(reg::kAlControl.address); }
+  std::uint16_t alStatus() const { return reg16(reg::kAlStatus.address); }
+  void pdiSetAlStatus(std::uint16_t status, std::uint16_t code);
+
+  // Mailbox: the SM in mailbox mode with ECAT write direction (normally SM0) and with ECAT read
+  // direction (normally SM1). Returns false when there is none or it is not enabled.
+  bool pdiMailboxAvailable() const;
+  // Copies a received mailbox into out (size = SM length) and frees SM0. Returns bytes copied
+  // or 0 when SM0 holds nothing.
+  std::size_t pdiMailboxReceive(Bytes out);
+  // Puts a response into SM1 if it is empty; returns false when SM1 is still full.
+  bool pdiMailboxSend(ConstBytes data);
+  bool pdiMailboxResponsePending() const;
+  // Repeat request handling: re-present the last mailbox response.
+  void pdiMailboxRepeat();
+
+  // Process data: the newest complete buffer of an ECAT-write SM, and write a complete buffer
+  // into an ECAT-read SM. Returns an empty span / false when the SM is not a buffered SM.
+  ConstBytes pdiOutputs(unsigned sm) const;
+  // True once the master completed at least one buffer of this output SM since it was enabled.
+  bool pdiOutputsReceived(unsigned sm) const { return sm < sm_.size() && sm_[sm].hasLatest; }
+  bool hasEvents() const {
+    return events_.alControlWritten || events_.mailboxReceived || events_.mailboxRead ||
+           events_.smConfigChanged || events_.outputsWritten || events_.eepromReloaded ||
+           events_.dcLatched || events_.dlControlWritten;
+  }
+  bool pdiWriteInputs(unsigned sm, ConstBytes data);
+
+  // SM configuration as the master programmed it.
+  struct SmConfig {
+    std::uint16_t start{0};
+    std::uint16_t length{0};
+    std::uint8_t control{0};
+    bool enabled{false};
+  };
+  SmConfig smConfig(unsigned sm) const;
+  struct FmmuConfig {
+    std::uint32_t logicalStart{0};
+    std::uint16_t length{0};
+    std::uint8_t logicalStartBit{0};
+    std::uint8_t logicalStopBit{7};
+    std::uint16_t physicalStart{0};
+    std::uint8_t physicalStartBit{0};
+    std::uint8_t type{0};
+    bool active{false};
+  };
+  FmmuConfig fmmuConfig(unsigned n) const;
+
+  const EscEvents& peekEvents() const { return events_; }
+  EscEvents takeEvents() {
+    EscEvents e = events_;
+    events_ = {};
+    return e;
+  }
+
+  // Raw register access for tests, the status view and fault injection.
+  std::uint8_t reg8(std::uint16_t address) const { return memory_[address]; }
+  std::uint16_t reg16(std::uint16_t address) const { return readLe16(memory_, address); }
+  std::uint32_t reg32(std::uint16_t address) const { return readLe32(memory_, address); }
+  std::uint64_t reg64(std::uint16_t address) const { return readLe64(memory_, address); }
+  void pdiWrite8(std::uint16_t address, std::uint8_t v) { memory_[address] = v; }
+  void pdiWrite16(std::uint16_t address, std::uint16_t v) { writeLe16(memory_, address, v); }
+  void pdiWrite32(std::uint16_t address, std::uint32_t v) { writeLe32(memory_, address, v); }
+  void pdiWrite64(std::uint16_t address, std::uint64_t v) { writeLe64(memory_, address, v); }
+  std::size_t memorySize() const { return memory_.size(); }
+
+  // Error counters (0x0300-0x0313), saturating at 0xFF as the datasheet specifies.
+  void countRxError(unsigned port, bool invalidFrame);
+  void countLostLink(unsigned port);
+
+  // The SII EEPROM content (words), e.g. for persisting writes or inspecting.
+  const std::vector<std::uint8_t>& sii() const { return sii_; }
+
+  // Power cycle: registers back to reset values, EEPROM content kept, reloaded.
+  void powerOnReset();
+
+  const EscCounters& counters() const { return counters_; }
+
+ private:
+  struct SmState {
+    // 3-buffer mode: three buffers of `length` bytes in buffers_. `latest` holds the newest
+    // complete one (for the reader), `writing` is the one the writer fills.
+    std::uint16_t bufferOffset{0};  // into buffers_
+    std::uint8_t latest{0};
+    std::uint8_t writing{1};
+    bool hasLatest{false};
+    bool mailboxFull{false};
+  };
+
+  void reset();
+  void loadFromSii();
+  // ECAT access to [address, address + size): registers with write masks and side effects,
+  // process RAM through the SyncManagers. Return false when no byte could be accessed (an SM
+  // blocked it), which means no working-counter increment.
+  bool readMemory(std::uint32_t address, Bytes out, bool orInto);
+  bool writeMemory(std::uint32_t address, ConstBytes data);
+  // Process RAM access for one contiguous piece inside one SM (sm >= 0) or outside any (-1).
+  bool readRam(std::uint16_t address, Bytes out, bool orInto, int sm);
+  bool writeRam(std::uint16_t address, ConstBytes data, int sm);
+  void writeRegisters(std::uint16_t address, ConstBytes data);
+  void refreshVolatile(std::uint16_t begin, std::uint16_t end, SimTime localTime);
+  void siiCommand(std::uint16_t control);
+  void smActivationChanged(unsigned sm);
+  int smCovering(std::uint16_t address) const;
+  // Logical addressing through FMMUs. Returns {readHit, writeHit}.
+  std::pair<bool, bool> processLogical(DatagramView d, bool doRead, bool doWrite);
+  void latchReceiveTimes(SimTime localTime);
+
+  const EscType type_;
+  std::vector<std::uint8_t> memory_;    // registers 0x0000-0x0FFF + process RAM
+  std::vector<std::uint8_t> writable_;  // per register byte: ECAT write mask
+  std::vector<std::uint8_t> buffers_;   // 3-buffer storage, 3 * length per buffered SM
+  std::vector<std::uint8_t> sii_;
+  std::array<SmState, reg::kMaxSyncManagers> sm_{};
+  std::vector<std::uint8_t> lastMailboxResponse_;
+  std::size_t lastMailboxResponseSize_{0};
+  bool latchArmed_{false};
+  EscEvents events_{};
+  EscCounters counters_{};
+  struct ActiveFmmu {
+    std::uint64_t logicalStartBit;  // absolute logical bit address
+    std::uint64_t logicalEndBit;    // inclusive
+    std::uint32_t physicalStartBit;
+    std::uint8_t type;
+    bool byteAligned;
+  };
+  void rebuildFmmuCache();
+
+  std::array<ActiveFmmu, reg::kMaxFmmus> activeFmmus_{};
+  std::uint8_t activeFmmuCount_{0};
+  std::array<std::uint8_t, kMaxDatagramLength + 1> scratch_{};
+  std::uint16_t lastWkcIncrement_{0};
+};
+
+}  // namespace ecsim::slavesim

@@ -1,0 +1,35 @@
+#include "slavesim/slave.hpp"
+
+namespace ecsim::slavesim {
+
+Slave::Slave(std::string name, const EscType& type, std::vector<std::uint8_t> sii,
+             SlaveProfile profile)
+    : name_(std::move(name)),
+      esc_(type, std::move(sii)),
+      profile_(std::move(profile)),
+      mailboxBuffer_(static_cast<std::size_t>(type.ramKb) * 1024) {}
+
+void Slave::poll(SimTime now) {
+  EscEvents events = esc_.takeEvents();
+  if (events.alControlWritten) {
+    if (device_) device_->updateProfile(profile_);
+    esm_.onAlControl(esc_, profile_);
+  }
+  if (events.mailboxReceived && mailbox_) {
+    std::size_t n = esc_.pdiMailboxReceive(mailboxBuffer_);
+    if (n > 0) mailbox_->onRequest(esc_, ConstBytes(mailboxBuffer_.data(), n), now);
+  }
+  if (events.mailboxRead) {
+    // A toggled repeat request (SM1 activate bit 1 != PDI control bit 1) asks for the last
+    // response again (ETG.1000.4 mailbox repeat).
+    const std::uint16_t base = reg::smChannel(1);
+    bool req =
+        (esc_.reg8(base + reg::sm::kActivate.address) & reg::sm::kActivateRepeatRequest) != 0;
+    bool ackBit = (esc_.reg8(base + reg::sm::kPdiControl.address) & reg::sm::kPdiRepeatAck) != 0;
+    if (req != ackBit) esc_.pdiMailboxRepeat();
+  }
+  if (mailbox_) mailbox_->poll(esc_, now);
+  if (device_) device_->step(esc_, state(), now);
+}
+
+}  // namespace ecsim::slavesim

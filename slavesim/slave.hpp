@@ -1,0 +1,65 @@
+// A simulated slave: its ESC plus the firmware behind the PDI (state machine, mailbox server,
+// device model). The firmware runs between frames, when the ESC reports events, and on the
+// device's own tick.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "slavesim/al_state_machine.hpp"
+#include "slavesim/esc.hpp"
+
+namespace ecsim::slavesim {
+
+// Protocol server reached through the mailbox (CoE, later FoE/EoE): gets each request and
+// answers through Esc::pdiMailboxSend.
+class MailboxServer {
+ public:
+  virtual ~MailboxServer() = default;
+  virtual void onRequest(Esc& esc, ConstBytes mailbox, SimTime now) = 0;
+  // Called when the firmware is polled; lets the server push queued responses.
+  virtual void poll(Esc& /*esc*/, SimTime /*now*/) {}
+};
+
+// The application behind the ESC (IO terminal, drive...). It sees only the PDI side.
+class Device {
+ public:
+  virtual ~Device() = default;
+  // Current expectations for the ESM checks (mailbox, PDO sizes).
+  virtual void updateProfile(SlaveProfile& /*profile*/) {}
+  // Called after an AL state change and periodically; exchanges process data with the ESC.
+  virtual void step(Esc& /*esc*/, AlState /*state*/, SimTime /*now*/) {}
+};
+
+class Slave {
+ public:
+  Slave(std::string name, const EscType& type, std::vector<std::uint8_t> sii, SlaveProfile profile);
+
+  const std::string& name() const { return name_; }
+  Esc& esc() { return esc_; }
+  const Esc& esc() const { return esc_; }
+  SlaveProfile& profile() { return profile_; }
+  AlState state() const { return AlStateMachine::state(esc_); }
+
+  void setMailboxServer(std::unique_ptr<MailboxServer> server) { mailbox_ = std::move(server); }
+  void setDevice(std::unique_ptr<Device> device) { device_ = std::move(device); }
+  MailboxServer* mailboxServer() { return mailbox_.get(); }
+  Device* device() { return device_.get(); }
+
+  // Runs the firmware: reacts to ESC events (AL control, mailbox) and steps the device.
+  void poll(SimTime now);
+
+  AlStateMachine& stateMachine() { return esm_; }
+
+ private:
+  std::string name_;
+  Esc esc_;
+  SlaveProfile profile_;
+  AlStateMachine esm_;
+  std::unique_ptr<MailboxServer> mailbox_;
+  std::unique_ptr<Device> device_;
+  std::vector<std::uint8_t> mailboxBuffer_;
+};
+
+}  // namespace ecsim::slavesim

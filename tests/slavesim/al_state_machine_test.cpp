@@ -1,0 +1,174 @@
+// The EtherCAT state machine against ETG.1000.6 / ESC datasheet section I §10: allowed and
+// refused transitions with their AL status codes, error acknowledge, and the configuration
+// checks a real slave makes (mailbox SMs at INIT->PREOP, process-data SMs at PREOP->SAFEOP,
+// valid outputs at SAFEOP->OP).
+#include <gtest/gtest.h>
+
+#include "protocol/al_status.hpp"
+#include "support/test_network.hpp"
+
+namespace ecsim::testing {
+namespace {
+
+std::vector<std::uint8_t> smBytes(std::uint16_t start, std::uint16_t length, std::uint8_t control) {
+  std::vector<std::uint8_t> s(8, 0);
+  writeLe16(s, 0, start);
+  writeLe16(s, 2, length);
+  s[4] = control;
+  s[6] = 1;
+  return s;
+}
+
+class Esm : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    slavesim::SlaveProfile p;
+    p.mailbox = slavesim::SlaveProfile::Mailbox{0x1000, 128, 0x1080, 128};
+    p.processData = {{2, true, 2}, {3, false, 4}};
+    seg_.addSlave(makeSlave("drive", 7, p, makeSii(0xABCD, 7, 0x1000, 128, 0x1080, 128)));
+    one(seg_, Command::kApwr, phys(0, 0x0010), le16(0x1001));
+  }
+  void request(std::uint16_t control) {
+    one(seg_, Command::kFpwr, phys(0x1001, 0x0120), le16(control));
+  }
+  std::uint16_t status() {
+    return readLe16(one(seg_, Command::kFprd, phys(0x1001, 0x0130), {0, 0}).data, 0);
+  }
+  std::uint16_t code() {
+    return readLe16(one(seg_, Command::kFprd, phys(0x1001, 0x0134), {0, 0}).data, 0);
+  }
+  void configureMailbox() {
+    one(seg_, Command::kFpwr, phys(0x1001, 0x0800), smBytes(0x1000, 128, 0x26));
+    one(seg_, Command::kFpwr, phys(0x1001, 0x0808), smBytes(0x1080, 128, 0x22));
+  }
+  void configureProcessData(std::uint16_t outLen = 2, std::uint16_t inLen = 4) {
+    one(seg_, Command::kFpwr, phys(0x1001, 0x0810), smBytes(0x1100, outLen, 0x64));
+    one(seg_, Command::kFpwr, phys(0x1001, 0x0818), smBytes(0x1180, inLen, 0x20));
+  }
+  topology::Segment seg_;
+};
+
+TEST_F(Esm, StartsInInit) {
+  EXPECT_EQ(status(), 0x0001);
+}
+
+TEST_F(Esm, InitToPreOpNeedsTheMailboxConfigured) {
+  request(0x0002);
+  EXPECT_EQ(status(), 0x0011) << "INIT + error";
+  EXPECT_EQ(code(), 0x0016) << "invalid mailbox configuration";
+  configureMailbox();
+  request(0x0012);  // PREOP with acknowledge
+  EXPECT_EQ(status(), 0x0002);
+  EXPECT_EQ(code(), 0x0000);
+}
+
+TEST_F(Esm, MailboxAtWrongAddressRefused) {
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0800), smBytes(0x1200, 128, 0x26));
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0808), smBytes(0x1080, 128, 0x22));
+  request(0x0002);
+  EXPECT_EQ(code(), 0x0016);
+}
+
+TEST_F(Esm, SkippingStatesIsInvalid) {
+  request(0x0004);
+  EXPECT_EQ(status(), 0x0011);
+  EXPECT_EQ(code(), 0x0011) << "INIT->SAFEOP: invalid requested state change";
+  configureMailbox();
+  request(0x0012);
+  request(0x0008);
+  EXPECT_EQ(status(), 0x0012);
+  EXPECT_EQ(code(), 0x0011) << "PREOP->OP";
+}
+
+TEST_F(Esm, UnknownStateCode) {
+  request(0x0005);
+  EXPECT_EQ(status(), 0x0011);
+  EXPECT_EQ(code(), 0x0012);
+}
+
+TEST_F(Esm, BootstrapNotSupportedWithoutBootMailbox) {
+  request(0x0003);
+  EXPECT_EQ(code(), 0x0013);
+}
+
+TEST_F(Esm, ErrorStaysUntilAcknowledged) {
+  request(0x0004);
+  ASSERT_EQ(status(), 0x0011);
+  configureMailbox();
+  request(0x0002);  // no ack: ignored
+  EXPECT_EQ(status(), 0x0011);
+  request(0x0012);
+  EXPECT_EQ(status(), 0x0002);
+}
+
+TEST_F(Esm, PreOpToSafeOpChecksProcessDataSms) {
+  configureMailbox();
+  request(0x0012);
+  configureProcessData(3, 4);  // outputs should be 2 bytes
+  request(0x0004);
+  EXPECT_EQ(status(), 0x0012);
+  EXPECT_EQ(code(), 0x001D) << "invalid output configuration";
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0816), {0});
+  one(seg_, Command::kFpwr, phys(0x1001, 0x081E), {0});
+  configureProcessData(2, 5);
+  request(0x0014);
+  EXPECT_EQ(code(), 0x001E) << "invalid input configuration";
+  one(seg_, Command::kFpwr, phys(0x1001, 0x081E), {0});
+  configureProcessData(2, 4);
+  request(0x0014);
+  EXPECT_EQ(status(), 0x0004);
+}
+
+TEST_F(Esm, SafeOpToOpNeedsValidOutputs) {
+  configureMailbox();
+  request(0x0012);
+  configureProcessData();
+  request(0x0004);
+  ASSERT_EQ(status(), 0x0004);
+  request(0x0008);
+  EXPECT_EQ(status(), 0x0014);
+  EXPECT_EQ(code(), 0x0019) << "no valid outputs";
+  one(seg_, Command::kFpwr, phys(0x1001, 0x1100), {1, 2});
+  request(0x0018);
+  EXPECT_EQ(status(), 0x0008);
+}
+
+TEST_F(Esm, DownwardTransitionsAlwaysAllowed) {
+  configureMailbox();
+  request(0x0012);
+  configureProcessData();
+  request(0x0004);
+  one(seg_, Command::kFpwr, phys(0x1001, 0x1100), {1, 2});
+  request(0x0008);
+  ASSERT_EQ(status(), 0x0008);
+  request(0x0002);  // OP -> PREOP
+  EXPECT_EQ(status(), 0x0002);
+  request(0x0001);
+  EXPECT_EQ(status(), 0x0001);
+}
+
+TEST_F(Esm, BroadcastAlStatusOrsAllSlaves) {
+  seg_.addSlave(makeSlave("io", 8));
+  seg_.wireLine();
+  configureMailbox();
+  request(0x0012);
+  auto r = one(seg_, Command::kBrd, phys(0, 0x0130), {0, 0});
+  EXPECT_EQ(r.wkc, 2);
+  EXPECT_EQ(r.data[0], 0x03) << "PREOP | INIT";
+}
+
+TEST_F(Esm, FirmwareErrorDropsToSafeOp) {
+  configureMailbox();
+  request(0x0012);
+  configureProcessData();
+  request(0x0004);
+  one(seg_, Command::kFpwr, phys(0x1001, 0x1100), {1, 2});
+  request(0x0008);
+  ASSERT_EQ(status(), 0x0008);
+  seg_.slave(0).stateMachine().raiseError(seg_.slave(0).esc(), AlState::kSafeOp, 0x001B);
+  EXPECT_EQ(status(), 0x0014);
+  EXPECT_EQ(code(), 0x001B);
+}
+
+}  // namespace
+}  // namespace ecsim::testing

@@ -1,0 +1,111 @@
+// Frame forwarding through the wiring (ESC datasheet section I §3: processing order
+// 0->3->1->2, closed ports loop back), DL status bits as SOEM reads them, and the timing model
+// (wire time 80 ns/byte, 5 ns/m cable, per-ESC delay) feeding the DC receive-time latches.
+#include <gtest/gtest.h>
+
+#include "support/test_network.hpp"
+
+namespace ecsim::testing {
+namespace {
+
+TEST(Segment, DlStatusOfALine) {
+  topology::Segment seg;
+  buildLine(seg, 3);
+  // Last slave: port 0 link + communication, ports 1-3 closed (loop): 0x5611 as SOEM expects
+  // from a single/last slave (notes/soem-interop.md §3.2).
+  EXPECT_EQ(seg.slave(2).esc().reg16(0x0110), 0x5611);
+  // Middle slave: ports 0 and 1 open with communication.
+  EXPECT_EQ(seg.slave(1).esc().reg16(0x0110), 0x5A31);
+}
+
+TEST(Segment, TreeThroughAJunctionVisitsInPortOrder) {
+  // Junction J (4 ports): port 3 -> A, port 1 -> B, port 2 -> C. Processing order:
+  // J, A (via port 3), B (via port 1), C (via port 2): auto-increment positions follow it.
+  topology::Segment seg;
+  seg.addSlave(makeSlave("J", 1));
+  seg.addSlave(makeSlave("A", 2));
+  seg.addSlave(makeSlave("B", 3));
+  seg.addSlave(makeSlave("C", 4));
+  ASSERT_TRUE(seg.connect(0, 1, 2, 0).ok());
+  ASSERT_TRUE(seg.connect(0, 3, 1, 0).ok());
+  ASSERT_TRUE(seg.connect(0, 2, 3, 0).ok());
+  for (std::uint16_t pos = 0; pos < 4; ++pos) {
+    one(seg, Command::kApwr, phys(static_cast<std::uint16_t>(-pos), 0x0010),
+        le16(static_cast<std::uint16_t>(0x100 + pos)));
+  }
+  EXPECT_EQ(seg.slave(0).esc().reg16(0x0010), 0x100);
+  EXPECT_EQ(seg.slave(1).esc().reg16(0x0010), 0x101) << "A behind port 3 comes second";
+  EXPECT_EQ(seg.slave(2).esc().reg16(0x0010), 0x102);
+  EXPECT_EQ(seg.slave(3).esc().reg16(0x0010), 0x103);
+}
+
+TEST(Segment, CyclesAreRefused) {
+  topology::Segment seg;
+  buildLine(seg, 3);
+  auto s = seg.connect(2, 1, 0, 2);
+  EXPECT_FALSE(s.ok());
+}
+
+TEST(Segment, ClosedPortLoopsBackAndHidesTheRest) {
+  topology::Segment seg;
+  buildLine(seg, 3);
+  // Close port 1 of slave 0 through DL control (0x0101 bits 2-3 = 11: always closed).
+  one(seg, Command::kApwr, phys(0, 0x0101), {0x0C});
+  EXPECT_EQ(one(seg, Command::kBrd, phys(0, 0x0000), {0}).wkc, 1);
+  one(seg, Command::kApwr, phys(0, 0x0101), {0x00});
+  EXPECT_EQ(one(seg, Command::kBrd, phys(0, 0x0000), {0}).wkc, 3);
+}
+
+TEST(Segment, PulledCableLosesTheSlavesBehindIt) {
+  topology::Segment seg;
+  buildLine(seg, 4);
+  seg.setLinkUp(1, 1, false);
+  EXPECT_EQ(one(seg, Command::kBrd, phys(0, 0x0000), {0}).wkc, 2);
+  EXPECT_EQ(seg.slave(1).esc().reg8(0x0311), 1) << "lost link counter port 1";
+  EXPECT_EQ(seg.slave(1).esc().reg16(0x0110) & 0x0C00, 0x0400) << "port 1 now loops";
+  seg.setLinkUp(1, 1, true);
+  EXPECT_EQ(one(seg, Command::kBrd, phys(0, 0x0000), {0}).wkc, 4);
+}
+
+TEST(Segment, ReturnTimeFollowsTheWireModel) {
+  topology::Segment seg;
+  buildLine(seg, 10);
+  seg.setMasterCable(0.0);
+  std::array<std::uint8_t, kMaxFrameSize> buf{};
+  FrameBuilder b(buf, EthernetHeader{});
+  ASSERT_TRUE(b.add(Command::kBrd, 0, 0, 2).ok());
+  auto len = b.finish();
+  auto out = seg.processFrame(std::span(buf.data(), *len), 1000);
+  ASSERT_TRUE(out.delivered);
+  // A line of 10 with a 0 m master cable: forward, each slave's processing delay and a 1 m
+  // cable to the next; back, each but the last forwards once and the cable again.
+  const SimTime perEsc = slavesim::kEt1100.processingDelayNs;
+  const SimTime fwd = slavesim::kEt1100.forwardingDelayNs;
+  EXPECT_EQ(out.firstBitRoundTrip, 10 * perEsc + 9 * fwd + 2 * 9 * 5);
+  EXPECT_GT(out.firstBitRoundTrip, 10 * perEsc);
+  EXPECT_EQ(out.returnTime - 1000 - out.firstBitRoundTrip, (8 + 60 + 4) * 80)
+      << "last bit arrives one frame wire time after the first";
+}
+
+TEST(Segment, DcLatchMeasuresTheDownstreamRoundTrip) {
+  topology::Segment seg;
+  buildLine(seg, 3);
+  seg.setMasterCable(0.0);
+  one(seg, Command::kBwr, phys(0, 0x0900), {0, 0, 0, 0}, 5000);
+  auto t0 = seg.slave(0).esc().reg32(0x0900);
+  auto t1 = seg.slave(0).esc().reg32(0x0904);
+  auto s1t0 = seg.slave(1).esc().reg32(0x0900);
+  auto s1t1 = seg.slave(1).esc().reg32(0x0904);
+  auto s2t0 = seg.slave(2).esc().reg32(0x0900);
+  EXPECT_EQ(t0, 5000u) << "arrival at port 0 of the first slave";
+  EXPECT_EQ(s1t0 - t0, slavesim::kEt1100.processingDelayNs + 5u) << "ESC delay + 1 m cable";
+  // What comes back to slave 0's port 1 has gone round slaves 1 and 2.
+  EXPECT_GT(t1, s2t0);
+  EXPECT_EQ((t1 - t0) - (s1t1 - s1t0), 2 * (slavesim::kEt1100.processingDelayNs + 5u) -
+                                           slavesim::kEt1100.processingDelayNs +
+                                           slavesim::kEt1100.forwardingDelayNs)
+      << "difference of port round trips = twice the hop between the slaves";
+}
+
+}  // namespace
+}  // namespace ecsim::testing

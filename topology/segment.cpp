@@ -1,0 +1,213 @@
+#include "topology/segment.hpp"
+
+#include <string>
+
+namespace ecsim::topology {
+namespace {
+
+// Frame processing order (datasheet section I §3.2 Table 10): 0 -> 3 -> 1 -> 2 -> 0.
+constexpr std::array<std::uint8_t, kPortCount> kNextPort{3, 2, 0, 1};
+
+constexpr std::uint8_t kDlLoopMask = 0x03;  // per port in DL control byte 1 (0x0101)
+constexpr std::uint8_t kDlLoopAlwaysClosed = 0x03;
+
+}  // namespace
+
+std::size_t Segment::addSlave(std::unique_ptr<slavesim::Slave> slave) {
+  const auto& type = slave->esc().type();
+  slaves_.push_back(std::move(slave));
+  links_.push_back({});
+  linkUp_.push_back({true, true, true, true});
+  clocks_.push_back({});
+  delays_.push_back({type.processingDelayNs, type.forwardingDelayNs});
+  parent_.push_back(static_cast<int>(slaves_.size() - 1));
+  arrival_.push_back({});
+  arrivalMask_.push_back(0);
+  stack_.reserve(slaves_.size() + 1);
+  refreshLinkStatus();
+  return slaves_.size() - 1;
+}
+
+int Segment::findRoot(int i) {
+  while (parent_[static_cast<std::size_t>(i)] != i) i = parent_[static_cast<std::size_t>(i)];
+  return i;
+}
+
+Status Segment::connect(std::size_t a, unsigned pa, std::size_t b, unsigned pb, double metres) {
+  if (a >= slaves_.size() || b >= slaves_.size() || pa >= kPortCount || pb >= kPortCount) {
+    return makeError(ErrorCode::kInvalidArgument, "connect: slave or port out of range");
+  }
+  if (pa >= slaves_[a]->esc().type().maxPorts || pb >= slaves_[b]->esc().type().maxPorts) {
+    return makeError(ErrorCode::kInvalidArgument,
+                     "connect: " + slaves_[a]->name() + " port " + std::to_string(pa) + " or " +
+                         slaves_[b]->name() + " port " + std::to_string(pb) +
+                         " does not exist on its ESC");
+  }
+  if (links_[a][pa].slave != kNoSlave || links_[b][pb].slave != kNoSlave) {
+    return makeError(ErrorCode::kInvalidArgument, "connect: port already connected");
+  }
+  int ra = findRoot(static_cast<int>(a));
+  int rb = findRoot(static_cast<int>(b));
+  if (ra == rb) {
+    return makeError(ErrorCode::kInvalidArgument,
+                     "connect: " + slaves_[a]->name() + " and " + slaves_[b]->name() +
+                         " are already connected (the topology must be a tree)");
+  }
+  parent_[static_cast<std::size_t>(rb)] = ra;
+  links_[a][pa] = {static_cast<int>(b), static_cast<std::uint8_t>(pb), metres};
+  links_[b][pb] = {static_cast<int>(a), static_cast<std::uint8_t>(pa), metres};
+  refreshLinkStatus();
+  return okStatus();
+}
+
+void Segment::wireLine(double metres) {
+  for (std::size_t i = 1; i < slaves_.size(); ++i) {
+    (void)connect(i - 1, 1, i, 0, metres);
+  }
+}
+
+void Segment::setDelays(std::size_t slave, SimTime processing, SimTime forwarding) {
+  delays_[slave] = {processing, forwarding};
+}
+
+bool Segment::portOpen(std::size_t s, unsigned p) const {
+  const PortLink& l = links_[s][p];
+  if (l.slave == kNoSlave || !linkUp_[s][p]) return false;
+  if (!linkUp_[static_cast<std::size_t>(l.slave)][l.port]) return false;
+  const std::uint8_t loop = slaves_[s]->esc().reg8(reg::kDlControl.address + 1);
+  return ((loop >> (2 * p)) & kDlLoopMask) != kDlLoopAlwaysClosed;
+}
+
+void Segment::setLinkUp(std::size_t s, unsigned p, bool up) {
+  if (s >= slaves_.size() || p >= kPortCount) return;
+  if (linkUp_[s][p] && !up) slaves_[s]->esc().countLostLink(p);
+  linkUp_[s][p] = up;
+  refreshLinkStatus();
+}
+
+void Segment::refreshLinkStatus() {
+  for (std::size_t s = 0; s < slaves_.size(); ++s) {
+    auto& esc = slaves_[s]->esc();
+    std::uint16_t dl = static_cast<std::uint16_t>(esc.reg16(reg::kDlStatus.address) & 0x000F);
+    for (unsigned p = 0; p < kPortCount; ++p) {
+      bool link = (s == 0 && p == 0)
+                      ? linkUp_[0][0]
+                      : (links_[s][p].slave != kNoSlave && linkUp_[s][p] &&
+                         linkUp_[static_cast<std::size_t>(links_[s][p].slave)][links_[s][p].port]);
+      bool open = (s == 0 && p == 0) ? link : portOpen(s, p);
+      if (link) dl |= reg::dl_status::physicalLink(p);
+      if (!open) dl |= reg::dl_status::loopPort(p);
+      if (open) dl |= reg::dl_status::communication(p);
+    }
+    esc.pdiWrite16(reg::kDlStatus.address, dl);
+  }
+}
+
+FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
+  FrameOutcome outcome;
+  auto parsed = EtherCatFrame::parse(frame);
+  if (!parsed.ok() || slaves_.empty() || !linkUp_[0][0]) {
+    if (!parsed.ok()) ++counters_.framesMalformed;
+    return outcome;
+  }
+  std::size_t count = 0;
+  std::array<std::size_t, 128> offsets{};
+  for (auto it = parsed->begin(); it != parsed->end() && count < datagrams_.size(); ++it) {
+    datagrams_[count] = *it;
+    offsets[count] = parsed->datagramsOffset() + it.offset();
+    ++count;
+  }
+  if (count == datagrams_.size()) {  // more datagrams than an EtherCAT frame can hold
+    ++counters_.framesMalformed;
+    return outcome;
+  }
+  ++counters_.framesProcessed;
+  counters_.datagramsProcessed += count;
+  frame[6] |= 0x02;  // an ESC sets the locally administered bit of the source MAC (§3)
+
+  const SimTime nsPerByte = timing_.nsPerByte;
+  // The first bit of the frame is preceded by preamble and SFD: header bytes pass after them.
+  const SimTime headerLead = 8 * nsPerByte;
+  stack_.clear();
+  for (auto& m : arrivalMask_) m = 0;
+  std::uint32_t s = 0;
+  std::uint8_t k = 0;
+  SimTime t = sendTime + cableDelay(masterCable_);
+  stack_.push_back({0, 0, 0});
+  arrival_[0][0] = t;
+  arrivalMask_[0] = 1;
+  // A passage through an ESC costs its processing delay when it went through the processing
+  // unit (entered at port 0) and its forwarding delay otherwise; looping back through a closed
+  // port inside the ESC adds nothing (section I §9.1.2, Table 30).
+  bool viaEpu = false;
+  while (true) {
+    if (k == 0) {
+      auto& esc = slaves_[s]->esc();
+      esc.beginFrame();
+      for (std::size_t i = 0; i < count; ++i) {
+        SimTime at = t + headerLead + static_cast<SimTime>(offsets[i]) * nsPerByte;
+        esc.processDatagram(datagrams_[i], clocks_[s].localTime(at));
+      }
+      viaEpu = true;
+    }
+    const std::uint8_t out = kNextPort[k];
+    Visit& top = stack_.back();
+    const bool upstream = out == top.entryPort;
+    if (!upstream && !portOpen(s, out)) {
+      k = out;  // closed or unconnected: the ESC loops the frame back internally
+      continue;
+    }
+    const SimTime tOut = t + delays_[s][viaEpu ? 0 : 1];
+    viaEpu = false;
+    if (upstream) {
+      stack_.pop_back();
+      if (stack_.empty()) {
+        outcome.firstBitRoundTrip = tOut + cableDelay(masterCable_) - sendTime;
+        break;
+      }
+      Visit& parent = stack_.back();
+      const PortLink& l = links_[parent.slave][parent.port];
+      s = parent.slave;
+      k = parent.port;
+      t = tOut + cableDelay(l.cableMetres);
+    } else {
+      const PortLink& l = links_[s][out];
+      top.port = out;
+      stack_.push_back({static_cast<std::uint32_t>(l.slave), l.port, l.port});
+      s = static_cast<std::uint32_t>(l.slave);
+      k = l.port;
+      t = tOut + cableDelay(l.cableMetres);
+    }
+    arrival_[s][k] = t;
+    arrivalMask_[s] = static_cast<std::uint8_t>(arrivalMask_[s] | (1u << k));
+  }
+  for (std::size_t i = 0; i < slaves_.size(); ++i) {
+    auto& esc = slaves_[i]->esc();
+    if (esc.receiveTimeLatchArmed()) {
+      std::array<SimTime, kPortCount> local{};
+      for (unsigned p = 0; p < kPortCount; ++p) local[p] = clocks_[i].localTime(arrival_[i][p]);
+      esc.completeReceiveTimeLatch(local, arrivalMask_[i]);
+    }
+  }
+  // The master has the frame when its last bit is in: wire footprint of the frame itself
+  // (preamble + SFD + frame + FCS).
+  const SimTime frameTime =
+      static_cast<SimTime>(8 + std::max<std::size_t>(frame.size(), kMinFrameSize) + 4) * nsPerByte;
+  outcome.delivered = true;
+  outcome.returnTime = sendTime + outcome.firstBitRoundTrip + frameTime;
+  return outcome;
+}
+
+void Segment::pollSlaves(SimTime now) {
+  bool dlChanged = false;
+  for (auto& slave : slaves_) {
+    dlChanged |= slave->esc().hasEvents() && slave->esc().peekEvents().dlControlWritten;
+    if (slave->esc().hasEvents() || slave->device() != nullptr ||
+        slave->mailboxServer() != nullptr) {
+      slave->poll(now);
+    }
+  }
+  if (dlChanged) refreshLinkStatus();
+}
+
+}  // namespace ecsim::topology

@@ -1,0 +1,130 @@
+// A network segment: slaves wired port to port, reached by the master at slave 0's port 0.
+// processFrame() carries one frame through the wiring exactly as EtherCAT does: entering a
+// slave at port 0 it passes the processing unit, then leaves through the next open port in the
+// order 0->3->1->2 (closed or unconnected ports loop back inside the ESC), and comes back out
+// of port 0 towards the master. Each hop's timing (wire time, cable, ESC delay) is modelled so
+// DC receive-time latches and the frame's return time follow the topology.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "protocol/bytes.hpp"
+#include "protocol/frame.hpp"
+#include "protocol/result.hpp"
+#include "protocol/time.hpp"
+#include "slavesim/slave.hpp"
+
+namespace ecsim::topology {
+
+constexpr unsigned kPortCount = 4;
+constexpr int kNoSlave = -1;
+
+struct PortLink {
+  int slave{kNoSlave};   // neighbour slave index, or kNoSlave
+  std::uint8_t port{0};  // neighbour's port
+  double cableMetres{1.0};
+};
+
+// Timing parameters (see docs/timing.md for sources).
+struct TimingModel {
+  // 100BASE-TX: 80 ns per byte (section I §9.3); a frame's wire footprint includes preamble +
+  // SFD (8 B), FCS (4 B) and the inter-frame gap (12 B).
+  SimTime nsPerByte{80};
+  double cableNsPerMetre{5.0};
+};
+
+// A slave's free-running local clock: local = t + offset + t * drift (ppm). Real ESC clocks
+// are 25 ppm-class quartz oscillators; defaults are an ideal clock.
+struct ClockModel {
+  SimTime offset{0};
+  double driftPpm{0.0};
+  SimTime localTime(SimTime t) const {
+    return t + offset + static_cast<SimTime>(static_cast<double>(t) * driftPpm * 1e-6);
+  }
+};
+
+struct FrameOutcome {
+  bool delivered{false};  // false: dropped (malformed or lost)
+  SimTime returnTime{0};  // when the last bit is back at the master
+  SimTime firstBitRoundTrip{0};
+};
+
+struct SegmentCounters {
+  std::uint64_t framesProcessed{0};
+  std::uint64_t framesMalformed{0};
+  std::uint64_t datagramsProcessed{0};
+};
+
+class Segment {
+ public:
+  Segment() = default;
+  Segment(const Segment&) = delete;
+  Segment& operator=(const Segment&) = delete;
+
+  // Adds a slave; returns its index (position in processing order is set by the wiring).
+  std::size_t addSlave(std::unique_ptr<slavesim::Slave> slave);
+  // Connects a's port pa to b's port pb with a cable of the given length.
+  Status connect(std::size_t a, unsigned pa, std::size_t b, unsigned pb, double metres = 1.0);
+  // Wires slaves 0..n-1 as a line (port 1 of each to port 0 of the next).
+  void wireLine(double metres = 1.0);
+  void setMasterCable(double metres) { masterCable_ = metres; }
+  void setClock(std::size_t slave, const ClockModel& clock) { clocks_[slave] = clock; }
+  const ClockModel& clock(std::size_t slave) const { return clocks_[slave]; }
+  // ESC delays in ns: through the processing unit (port 0 -> next port) and forwarding
+  // (any other port -> next port). Defaults come from the slave's ESC type.
+  void setDelays(std::size_t slave, SimTime processing, SimTime forwarding);
+
+  std::size_t size() const { return slaves_.size(); }
+  slavesim::Slave& slave(std::size_t i) { return *slaves_[i]; }
+  const slavesim::Slave& slave(std::size_t i) const { return *slaves_[i]; }
+  const std::array<PortLink, kPortCount>& ports(std::size_t i) const { return links_[i]; }
+
+  // Processes a frame in place. sendTime is when its first bit leaves the master. A frame
+  // that is not a valid EtherCAT frame is left untouched, counted and reported as dropped.
+  FrameOutcome processFrame(Bytes frame, SimTime sendTime);
+  // Runs every slave's firmware (call after frames and on the device tick).
+  void pollSlaves(SimTime now);
+
+  // Updates each slave's DL status (0x0110) from the wiring and port states.
+  void refreshLinkStatus();
+  // Opens or closes a port (a pulled cable closes both ends' links).
+  void setLinkUp(std::size_t slave, unsigned port, bool up);
+
+  const SegmentCounters& counters() const { return counters_; }
+  const TimingModel& timing() const { return timing_; }
+  void setTiming(const TimingModel& t) { timing_ = t; }
+
+ private:
+  bool portOpen(std::size_t slave, unsigned port) const;
+  SimTime cableDelay(double metres) const {
+    return static_cast<SimTime>(metres * timing_.cableNsPerMetre + 0.5);
+  }
+
+  std::vector<std::unique_ptr<slavesim::Slave>> slaves_;
+  std::vector<std::array<PortLink, kPortCount>> links_;
+  std::vector<std::array<bool, kPortCount>> linkUp_;
+  std::vector<ClockModel> clocks_;
+  std::vector<std::array<SimTime, 2>> delays_;  // processing, forwarding
+  std::vector<int> parent_;                     // union-find for the tree check
+  std::vector<std::array<SimTime, kPortCount>> arrival_;
+  std::vector<std::uint8_t> arrivalMask_;
+  int findRoot(int i);
+  double masterCable_{1.0};
+  TimingModel timing_{};
+  SegmentCounters counters_{};
+  // Scratch for the datagram views of the frame in flight (no allocation per frame).
+  std::array<DatagramView, 128> datagrams_{};
+  struct Visit {
+    std::uint32_t slave;
+    std::uint8_t entryPort;
+    std::uint8_t port;  // port at which the frame currently is (received on)
+  };
+  std::vector<Visit> stack_;
+};
+
+}  // namespace ecsim::topology
