@@ -1,0 +1,164 @@
+#include "link/raw_socket_link.hpp"
+
+#include <arpa/inet.h>
+#include <net/if.h>
+#include <netpacket/packet.h>
+#include <sys/ioctl.h>
+#include <sys/socket.h>
+
+#include <cerrno>
+#include <cstring>
+
+#include "link/net_namespace.hpp"
+
+namespace ecsim {
+namespace {
+
+std::string where(std::string_view interface, std::string_view netns) {
+  std::string s = "interface '" + std::string(interface) + "'";
+  if (!netns.empty()) s += " in network namespace '" + std::string(netns) + "'";
+  return s;
+}
+
+Status checkInterfaceName(std::string_view interface) {
+  if (interface.empty() || interface.size() >= IFNAMSIZ) {
+    return makeError(ErrorCode::kInvalidArgument, "interface name '" + std::string(interface) +
+                                                      "' must have 1 to " +
+                                                      std::to_string(IFNAMSIZ - 1) + " characters");
+  }
+  return okStatus();
+}
+
+ifreq interfaceRequest(std::string_view interface) {
+  ifreq ifr{};
+  std::memcpy(ifr.ifr_name, interface.data(), interface.size());  // checked < IFNAMSIZ
+  return ifr;
+}
+
+}  // namespace
+
+Result<RawSocketLink> RawSocketLink::open(std::string_view interface,
+                                          const RawSocketOptions& options) {
+  ECSIM_TRY(checkInterfaceName(interface));
+  RawSocketLink link;
+  link.interface_ = std::string(interface);
+  link.netns_ = options.netns;
+  const std::string place = where(interface, options.netns);
+
+  // Protocol 0 at creation: the socket receives nothing until bind() names the interface and
+  // EtherType, so no frame from another interface slips in between.
+  ECSIM_TRY(runInNetworkNamespace(options.netns, [&]() -> Status {
+    link.fd_.reset(::socket(AF_PACKET, SOCK_RAW | SOCK_CLOEXEC, 0));
+    if (link.fd_.valid()) return okStatus();
+    const int err = errno;
+    if (err == EPERM || err == EACCES) {
+      return makeError(
+          ErrorCode::kPermission,
+          "opening a raw AF_PACKET socket for " + place +
+              " needs CAP_NET_RAW (run as root or grant cap_net_raw): " + errnoText(err));
+    }
+    return makeError(ErrorCode::kIo, "socket(AF_PACKET) for " + place + ": " + errnoText(err));
+  }));
+  const int fd = link.fd_.get();
+
+  ifreq ifr = interfaceRequest(interface);
+  if (::ioctl(fd, SIOCGIFINDEX, &ifr) != 0) {
+    const int err = errno;
+    if (err == ENODEV) return makeError(ErrorCode::kNotFound, place + " does not exist");
+    return makeError(ErrorCode::kIo, "SIOCGIFINDEX for " + place + ": " + errnoText(err));
+  }
+  link.ifindex_ = ifr.ifr_ifindex;
+  ifr = interfaceRequest(interface);
+  if (::ioctl(fd, SIOCGIFHWADDR, &ifr) == 0) {
+    for (std::size_t i = 0; i < link.mac_.size(); ++i) {
+      link.mac_[i] = static_cast<std::uint8_t>(ifr.ifr_hwaddr.sa_data[i]);
+    }
+  }
+
+  const int one = 1;
+  if (::setsockopt(fd, SOL_PACKET, PACKET_IGNORE_OUTGOING, &one, sizeof one) == 0) {
+    link.kernelIgnoresOutgoing_ = true;
+  }  // else: older kernel, receive() filters on sll_pkttype
+
+  sockaddr_ll addr{};
+  addr.sll_family = AF_PACKET;
+  addr.sll_protocol = htons(kEtherTypeEtherCat);
+  addr.sll_ifindex = link.ifindex_;
+  if (::bind(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) != 0) {
+    return makeError(ErrorCode::kIo, "binding raw socket to " + place + ": " + errnoText(errno));
+  }
+
+  if (options.promiscuous) {
+    packet_mreq mreq{};
+    mreq.mr_ifindex = link.ifindex_;
+    mreq.mr_type = PACKET_MR_PROMISC;
+    if (::setsockopt(fd, SOL_PACKET, PACKET_ADD_MEMBERSHIP, &mreq, sizeof mreq) != 0) {
+      return makeError(ErrorCode::kIo, "promiscuous mode on " + place + ": " + errnoText(errno));
+    }
+  }
+  return link;
+}
+
+Status RawSocketLink::send(ConstBytes frame) {
+  if (frame.size() < kEthernetHeaderSize || frame.size() > kMaxFrameSize) {
+    return makeError(
+        frame.size() > kMaxFrameSize ? ErrorCode::kTooLarge : ErrorCode::kInvalidArgument,
+        describe() + ": frame of " + std::to_string(frame.size()) + " bytes (allowed " +
+            std::to_string(kEthernetHeaderSize) + " to " + std::to_string(kMaxFrameSize) + ")");
+  }
+  for (;;) {
+    const ssize_t n = ::send(fd_.get(), frame.data(), frame.size(), 0);
+    if (n == static_cast<ssize_t>(frame.size())) return okStatus();
+    if (n >= 0) {
+      return makeError(ErrorCode::kIo, describe() + ": short send of " + std::to_string(n) +
+                                           " of " + std::to_string(frame.size()) + " bytes");
+    }
+    if (errno == EINTR) continue;
+    const int err = errno;
+    if (err == ENETDOWN || err == ENXIO) {
+      return makeError(ErrorCode::kIo, describe() + " is down: " + errnoText(err));
+    }
+    return makeError(ErrorCode::kIo, describe() + ": send: " + errnoText(err));
+  }
+}
+
+Result<std::size_t> RawSocketLink::receive(Bytes buffer, std::chrono::nanoseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    sockaddr_ll from{};
+    socklen_t fromLength = sizeof from;
+    // MSG_TRUNC: the return value is the real frame length even when the buffer is smaller.
+    const ssize_t n = ::recvfrom(fd_.get(), buffer.data(), buffer.size(), MSG_DONTWAIT | MSG_TRUNC,
+                                 reinterpret_cast<sockaddr*>(&from), &fromLength);
+    if (n > 0) {
+      if (from.sll_pkttype == PACKET_OUTGOING) {
+        ++outgoingSkipped_;
+        continue;
+      }
+      const auto length = static_cast<std::size_t>(n);
+      if (length > buffer.size()) {
+        return makeError(ErrorCode::kTooLarge, describe() + ": frame of " + std::to_string(length) +
+                                                   " bytes exceeds receive buffer of " +
+                                                   std::to_string(buffer.size()) +
+                                                   " bytes, frame dropped");
+      }
+      return length;
+    }
+    if (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) {
+      return makeError(ErrorCode::kIo, describe() + ": recvfrom: " + errnoText(errno));
+    }
+    if (n < 0 && errno == EINTR) return std::size_t{0};
+    const auto left = deadline - std::chrono::steady_clock::now();
+    if (left <= std::chrono::nanoseconds::zero()) return std::size_t{0};
+    ECSIM_ASSIGN_OR_RETURN(
+        const bool readable,
+        waitReadable(fd_.get(), std::chrono::duration_cast<std::chrono::nanoseconds>(left)));
+    if (!readable) return std::size_t{0};
+  }
+}
+
+std::string RawSocketLink::describe() const {
+  return "raw socket on " + where(interface_, netns_);
+}
+
+}  // namespace ecsim

@@ -1,0 +1,66 @@
+// RawSocketLink: an AF_PACKET raw socket on one network interface (a veth end, a TAP device
+// or a real NIC), bound to EtherType 0x88A4 so that only EtherCAT frames arrive. Frames the
+// socket sends itself are never received back (PACKET_IGNORE_OUTGOING where the kernel has
+// it, and a check of sll_pkttype == PACKET_OUTGOING in any case). The interface is put in
+// promiscuous mode through a packet-socket membership, which the kernel drops when the socket
+// closes. Needs CAP_NET_RAW.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#include "link/fd.hpp"
+#include "link/link.hpp"
+#include "protocol/ethernet.hpp"
+
+namespace ecsim {
+
+struct RawSocketOptions {
+  // Create the socket inside this named network namespace (/var/run/netns/NAME); the socket
+  // stays there while the calling thread returns to its own namespace. Empty: current one.
+  std::string netns;
+  bool promiscuous{true};
+};
+
+class RawSocketLink final : public Link {
+ public:
+  // Errors: kPermission (naming CAP_NET_RAW) when socket() is refused, kNotFound naming the
+  // interface (and namespace) when it does not exist, kInvalidArgument for a bad name.
+  static Result<RawSocketLink> open(std::string_view interface,
+                                    const RawSocketOptions& options = {});
+
+  RawSocketLink(RawSocketLink&&) noexcept = default;
+  RawSocketLink& operator=(RawSocketLink&&) noexcept = default;
+  ~RawSocketLink() override = default;
+
+  // Frames must hold an Ethernet header and be at most kMaxFrameSize bytes; the kernel sends
+  // them as they are (no padding is added on virtual interfaces).
+  Status send(ConstBytes frame) override;
+  Result<std::size_t> receive(Bytes buffer, std::chrono::nanoseconds timeout) override;
+  int pollFd() const override { return fd_.get(); }
+  std::string describe() const override;
+
+  const std::string& interfaceName() const { return interface_; }
+  int interfaceIndex() const { return ifindex_; }
+  const MacAddress& macAddress() const { return mac_; }
+  // True when the kernel itself drops our outgoing frames (PACKET_IGNORE_OUTGOING, Linux
+  // >= 4.20); otherwise receive() skips them by their packet type.
+  bool kernelIgnoresOutgoing() const { return kernelIgnoresOutgoing_; }
+  // Own frames that reached receive() and were skipped (only without kernel support).
+  std::uint64_t outgoingSkipped() const { return outgoingSkipped_; }
+
+ private:
+  RawSocketLink() = default;
+
+  UniqueFd fd_;
+  std::string interface_;
+  std::string netns_;
+  int ifindex_{0};
+  MacAddress mac_{};
+  bool kernelIgnoresOutgoing_{false};
+  std::uint64_t outgoingSkipped_{0};
+};
+
+}  // namespace ecsim
