@@ -20,8 +20,9 @@ class Link {
   virtual Status send(ConstBytes frame) = 0;
 
   // Receives one frame into buffer. Waits at most timeout (zero: do not wait). Returns the
-  // frame length, or 0 when nothing arrived in time. A frame longer than buffer is dropped
-  // and reported as an error.
+  // frame length, or 0 when nothing arrived in time (or a signal ended the wait early, so a
+  // loop can look at its SignalFlag). A frame longer than buffer is dropped and reported as
+  // an error.
   virtual Result<std::size_t> receive(Bytes buffer, std::chrono::nanoseconds timeout) = 0;
 
   // A file descriptor that becomes readable when a frame is waiting, or -1.

@@ -1,0 +1,188 @@
+#include "link/raw_socket_link.hpp"
+
+#include <gtest/gtest.h>
+#include <poll.h>
+
+#include <array>
+#include <chrono>
+#include <string>
+#include <vector>
+
+#include "link/netns.hpp"
+#include "test_support.hpp"
+
+namespace ecsim {
+namespace {
+
+using namespace std::chrono_literals;
+using testing::etherCatFrame;
+using testing::otherFrame;
+
+class RawSocketLinkTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ECSIM_REQUIRE_NETWORK_PRIVILEGES();
+    auto created = VethNamespace::create();
+    ASSERT_TRUE(created.ok()) << created.error().message();
+    ns_ = std::make_unique<VethNamespace>(std::move(*created));
+  }
+
+  Result<RawSocketLink> open(const std::string& iface) {
+    return RawSocketLink::open(iface, RawSocketOptions{ns_->name(), true});
+  }
+
+  std::string promiscuity(const std::string& iface) {
+    auto out = ns_->run({"ip", "-d", "-o", "link", "show", iface});
+    if (!out.ok()) return "";
+    const auto at = out->output.find("promiscuity ");
+    return at == std::string::npos ? "" : out->output.substr(at, 13);
+  }
+
+  std::unique_ptr<VethNamespace> ns_;
+  std::array<std::uint8_t, kMaxFrameSize> buf_{};
+};
+
+TEST_F(RawSocketLinkTest, CarriesEtherCatFramesBetweenTheEnds) {
+  auto master = open(ns_->masterInterface());
+  ASSERT_TRUE(master.ok()) << master.error().message();
+  auto sim = open(ns_->simulatorInterface());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  EXPECT_NE(master->describe().find(ns_->masterInterface()), std::string::npos);
+  EXPECT_GT(master->interfaceIndex(), 0);
+  EXPECT_NE(master->macAddress(), MacAddress{});
+
+  const auto request = etherCatFrame(3);
+  ASSERT_TRUE(master->send(request).ok());
+  auto n = sim->receive(buf_, 2s);
+  ASSERT_TRUE(n.ok()) << n.error().message();
+  ASSERT_EQ(*n, request.size());
+  EXPECT_EQ(std::vector<std::uint8_t>(buf_.begin(), buf_.begin() + 60), request);
+
+  // The reply travels back, also to a unicast MAC that is not the interface's own.
+  const auto reply = etherCatFrame(4, {0x02, 0x00, 0x00, 0x00, 0x00, 0x99});
+  ASSERT_TRUE(sim->send(reply).ok());
+  n = master->receive(buf_, 2s);
+  ASSERT_TRUE(n.ok()) << n.error().message();
+  ASSERT_EQ(*n, reply.size());
+  EXPECT_EQ(std::vector<std::uint8_t>(buf_.begin(), buf_.begin() + 60), reply);
+}
+
+TEST_F(RawSocketLinkTest, DoesNotDeliverOtherEtherTypes) {
+  auto master = open(ns_->masterInterface());
+  auto sim = open(ns_->simulatorInterface());
+  ASSERT_TRUE(master.ok() && sim.ok());
+  ASSERT_TRUE(master->send(otherFrame()).ok());
+  ASSERT_TRUE(master->send(etherCatFrame(5)).ok());
+  // The first frame to arrive is the EtherCAT one; the 0x88B5 frame never queued.
+  auto n = sim->receive(buf_, 2s);
+  ASSERT_TRUE(n.ok());
+  ASSERT_EQ(*n, 60u);
+  EXPECT_EQ(readBe16(buf_, 12), kEtherTypeEtherCat);
+  EXPECT_EQ(buf_[kEthernetHeaderSize + 3], 5);  // datagram index
+  n = sim->receive(buf_, 100ms);
+  ASSERT_TRUE(n.ok());
+  EXPECT_EQ(*n, 0u);
+}
+
+TEST_F(RawSocketLinkTest, DoesNotReceiveItsOwnFrames) {
+  auto master = open(ns_->masterInterface());
+  auto sim = open(ns_->simulatorInterface());
+  ASSERT_TRUE(master.ok() && sim.ok());
+  EXPECT_TRUE(master->kernelIgnoresOutgoing());  // Linux >= 4.20
+  ASSERT_TRUE(master->send(etherCatFrame(6)).ok());
+  auto own = master->receive(buf_, 200ms);
+  ASSERT_TRUE(own.ok());
+  EXPECT_EQ(*own, 0u);
+  auto peer = sim->receive(buf_, 2s);
+  ASSERT_TRUE(peer.ok());
+  EXPECT_EQ(*peer, 60u);
+}
+
+TEST_F(RawSocketLinkTest, PollFdSignalsAWaitingFrame) {
+  auto master = open(ns_->masterInterface());
+  auto sim = open(ns_->simulatorInterface());
+  ASSERT_TRUE(master.ok() && sim.ok());
+  ASSERT_TRUE(master->send(etherCatFrame(7)).ok());
+  pollfd pfd{sim->pollFd(), POLLIN, 0};
+  ASSERT_EQ(::poll(&pfd, 1, 2000), 1);
+  auto n = sim->receive(buf_, 0ns);
+  ASSERT_TRUE(n.ok());
+  EXPECT_EQ(*n, 60u);
+}
+
+TEST_F(RawSocketLinkTest, TimesOutAndRefusesBadFrames) {
+  auto master = open(ns_->masterInterface());
+  ASSERT_TRUE(master.ok());
+  const auto start = std::chrono::steady_clock::now();
+  auto n = master->receive(buf_, 50ms);
+  ASSERT_TRUE(n.ok());
+  EXPECT_EQ(*n, 0u);
+  EXPECT_GE(std::chrono::steady_clock::now() - start, 50ms);
+
+  auto big = master->send(std::vector<std::uint8_t>(kMaxFrameSize + 1));
+  ASSERT_FALSE(big.ok());
+  EXPECT_EQ(big.error().code, ErrorCode::kTooLarge);
+  auto tiny = master->send(std::vector<std::uint8_t>(10));
+  ASSERT_FALSE(tiny.ok());
+  EXPECT_EQ(tiny.error().code, ErrorCode::kInvalidArgument);
+  EXPECT_TRUE(master->send(std::vector<std::uint8_t>(kMaxFrameSize, 0)).ok());
+}
+
+TEST_F(RawSocketLinkTest, SmallReceiveBufferIsAnError) {
+  auto master = open(ns_->masterInterface());
+  auto sim = open(ns_->simulatorInterface());
+  ASSERT_TRUE(master.ok() && sim.ok());
+  ASSERT_TRUE(master->send(etherCatFrame(8)).ok());
+  std::array<std::uint8_t, 32> small{};
+  auto n = sim->receive(small, 2s);
+  ASSERT_FALSE(n.ok());
+  EXPECT_EQ(n.error().code, ErrorCode::kTooLarge);
+}
+
+TEST_F(RawSocketLinkTest, PromiscuousWhileOpen) {
+  const std::string iface = ns_->simulatorInterface();
+  EXPECT_EQ(promiscuity(iface), "promiscuity 0");
+  {
+    auto sim = open(iface);
+    ASSERT_TRUE(sim.ok());
+    EXPECT_EQ(promiscuity(iface), "promiscuity 1");
+  }
+  EXPECT_EQ(promiscuity(iface), "promiscuity 0");
+}
+
+TEST_F(RawSocketLinkTest, NamesAMissingInterface) {
+  auto link = open("nosuchif0");
+  ASSERT_FALSE(link.ok());
+  EXPECT_EQ(link.error().code, ErrorCode::kNotFound);
+  EXPECT_NE(link.error().context.find("nosuchif0"), std::string::npos);
+  EXPECT_NE(link.error().context.find(ns_->name()), std::string::npos);
+
+  // The namespace's interfaces are not found outside it.
+  auto outside = RawSocketLink::open(ns_->masterInterface());
+  ASSERT_FALSE(outside.ok());
+  EXPECT_EQ(outside.error().code, ErrorCode::kNotFound);
+
+  auto noNamespace = RawSocketLink::open("lo", RawSocketOptions{"ecsim-no-such-namespace", true});
+  ASSERT_FALSE(noNamespace.ok());
+  EXPECT_EQ(noNamespace.error().code, ErrorCode::kNotFound);
+
+  auto tooLong = RawSocketLink::open("a-name-of-16-chr");
+  ASSERT_FALSE(tooLong.ok());
+  EXPECT_EQ(tooLong.error().code, ErrorCode::kInvalidArgument);
+}
+
+TEST_F(RawSocketLinkTest, NamesCapNetRawWhenRefused) {
+  const std::string netns = ns_->name();
+  const std::string iface = ns_->masterInterface();
+  const int code = testing::runWithoutCapability(CAP_NET_RAW, [&] {
+    auto link = RawSocketLink::open(iface, RawSocketOptions{netns, true});
+    if (link.ok()) return 1;
+    if (link.error().code != ErrorCode::kPermission) return 2;
+    if (link.error().context.find("CAP_NET_RAW") == std::string::npos) return 3;
+    return 0;
+  });
+  EXPECT_EQ(code, 0) << "1: opened anyway, 2: wrong code, 3: message lacks CAP_NET_RAW";
+}
+
+}  // namespace
+}  // namespace ecsim
