@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# One entry point for a fresh Debian 12 machine (run as root):
+#   ./run.sh demo   install what is missing, build, run `ecsim demo`
+#   ./run.sh test   install what is missing, build (default + asan presets), run every test
+# Both are idempotent: packages already present are not reinstalled, builds are incremental.
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")"
+
+packages=(
+  build-essential cmake ninja-build g++ clang libclang-rt-14-dev pkg-config
+  libgtest-dev libgmock-dev libbenchmark-dev
+  libtinyxml2-dev libpcap-dev libcli11-dev libfmt-dev libspdlog-dev nlohmann-json3-dev
+  libeigen3-dev tshark gnuplot-nox iproute2 ethtool procps
+)
+
+install_missing() {
+  local missing=()
+  for p in "${packages[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  if [ ${#missing[@]} -gt 0 ]; then
+    echo "run.sh: installing ${missing[*]}"
+    if [ "$(id -u)" -ne 0 ]; then echo "run.sh: run as root to install packages" >&2; exit 1; fi
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -qq
+    apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  fi
+}
+
+build() {  # build PRESET
+  cmake --preset "$1" >/dev/null
+  cmake --build --preset "$1"
+}
+
+case "${1:-}" in
+  demo)
+    install_missing
+    build default
+    ./build/default/tools/ecsim/ecsim demo --out ecsim-demo
+    ;;
+  test)
+    install_missing
+    build default
+    ctest --preset default -j2
+    build asan
+    ASAN_OPTIONS=detect_leaks=1 ctest --preset asan -j2
+    bash tests/fuzz/run_fuzz.sh build/fuzz 100000
+    ;;
+  *)
+    echo "usage: $0 demo|test" >&2
+    exit 2
+    ;;
+esac

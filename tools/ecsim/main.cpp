@@ -1,0 +1,22 @@
+// ecsim: a software EtherCAT network. `ecsim serve` answers a master on an interface,
+// `ecsim demo` gives the one-command tour.
+#include <fmt/core.h>
+#include <CLI/CLI.hpp>
+
+#include "tools/ecsim/commands.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"ecsim - a software EtherCAT network for hardware-in-the-loop testing"};
+  app.require_subcommand(1);
+  auto serve = ecsim::tools::addServeCommand(app);
+  auto demo = ecsim::tools::addDemoCommand(app);
+  CLI11_PARSE(app, argc, argv);
+  try {
+    if (app.got_subcommand("serve")) return serve();
+    if (app.got_subcommand("demo")) return demo();
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "ecsim: {}\n", e.what());
+    return 1;
+  }
+  return 1;
+}

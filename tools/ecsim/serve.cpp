@@ -1,0 +1,117 @@
+// `ecsim serve`: answer an EtherCAT master on a network interface (one end of a veth pair, a
+// TAP device, or a real NIC) as a line of simulated slaves.
+#include <fmt/core.h>
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "link/pcap.hpp"
+#include "link/pcap_tap.hpp"
+#include "link/raw_socket_link.hpp"
+#include "link/signal_flag.hpp"
+#include "link/tap_link.hpp"
+#include "slavesim/generic_slave.hpp"
+#include "tools/ecsim/commands.hpp"
+#include "topology/network_server.hpp"
+
+namespace ecsim::tools {
+namespace {
+
+struct ServeOptions {
+  std::string iface;
+  std::string tap;
+  std::string netns;
+  std::string pcap;
+  unsigned slaves{1};
+  bool paced{false};
+  bool quiet{false};
+};
+
+int runServe(const ServeOptions& o) {
+  if (o.iface.empty() == o.tap.empty()) {
+    fmt::print(stderr, "ecsim serve: give exactly one of --iface or --tap\n");
+    return 2;
+  }
+  std::unique_ptr<Link> link;
+  if (!o.iface.empty()) {
+    auto raw = RawSocketLink::open(o.iface, RawSocketOptions{o.netns, true});
+    if (!raw.ok()) {
+      fmt::print(stderr, "ecsim serve: {}\n", raw.error().message());
+      return 1;
+    }
+    link = std::make_unique<RawSocketLink>(std::move(raw).value());
+  } else {
+    auto tap = TapLink::open(o.tap);
+    if (!tap.ok()) {
+      fmt::print(stderr, "ecsim serve: {}\n", tap.error().message());
+      return 1;
+    }
+    link = std::make_unique<TapLink>(std::move(tap).value());
+  }
+
+  topology::Segment segment;
+  for (unsigned i = 0; i < o.slaves; ++i) {
+    segment.addSlave(slavesim::makeGenericSlave(fmt::format("Slave{}", i + 1), i + 1));
+  }
+  segment.wireLine();
+
+  RealClock clock;
+  WallClock wall;
+  std::optional<PcapWriter> writer;
+  std::unique_ptr<PcapTap> tap;
+  Link* served = link.get();
+  if (!o.pcap.empty()) {
+    auto w = PcapWriter::open(o.pcap);
+    if (!w.ok()) {
+      fmt::print(stderr, "ecsim serve: {}\n", w.error().message());
+      return 1;
+    }
+    writer.emplace(std::move(w).value());
+    tap = std::make_unique<PcapTap>(*link, *writer, wall);
+    served = tap.get();
+  }
+
+  topology::ServerOptions options;
+  options.paced = o.paced;
+  options.idleWait = std::chrono::milliseconds(10);
+  topology::NetworkServer server(*served, segment, clock, options);
+  SignalFlag stop;
+  if (!o.quiet) {
+    fmt::print("ecsim: serving {} slave(s) on {}{}\n", o.slaves, link->describe(),
+               o.pcap.empty() ? "" : fmt::format(", capturing to {}", o.pcap));
+    std::fflush(stdout);
+  }
+  auto status = server.run([&] { return stop.raised(); });
+  if (writer) (void)writer->close();
+  const auto& c = server.counters();
+  const auto& sc = segment.counters();
+  fmt::print(
+      "ecsim: stopped; frames received {}, answered {}, malformed dropped {}, "
+      "receive errors {}, send errors {}, datagrams {}\n",
+      c.framesReceived, c.framesAnswered, c.framesDropped, c.receiveErrors, c.sendErrors,
+      sc.datagramsProcessed);
+  if (!status.ok()) {
+    fmt::print(stderr, "ecsim serve: {}\n", status.error().message());
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace
+
+CommandRunner addServeCommand(CLI::App& app) {
+  auto opts = std::make_shared<ServeOptions>();
+  auto* cmd = app.add_subcommand("serve", "Answer an EtherCAT master on a network interface");
+  cmd->add_option("--iface", opts->iface, "Interface to serve (e.g. one end of a veth pair)");
+  cmd->add_option("--tap", opts->tap, "Create/open this TAP device and serve on it");
+  cmd->add_option("--netns", opts->netns, "Open the interface inside this network namespace");
+  cmd->add_option("--slaves", opts->slaves, "Number of generic slaves in a line")
+      ->check(CLI::Range(1u, 65535u));
+  cmd->add_option("--pcap", opts->pcap, "Capture every frame to this pcap file");
+  cmd->add_flag("--paced", opts->paced, "Answer at the modelled round-trip time");
+  cmd->add_flag("--quiet", opts->quiet, "Print only the final statistics");
+  return [opts] { return runServe(*opts); };
+}
+
+}  // namespace ecsim::tools

@@ -1,0 +1,51 @@
+#include "topology/network_server.hpp"
+
+namespace ecsim::topology {
+
+NetworkServer::NetworkServer(Link& link, Segment& segment, const Clock& clock,
+                             ServerOptions options)
+    : link_(link), segment_(segment), clock_(clock), options_(options) {}
+
+Status NetworkServer::step() {
+  auto received = link_.receive(buffer_, options_.idleWait);
+  const SimTime now = clock_.now();
+  if (!received.ok()) {
+    ++counters_.receiveErrors;  // e.g. an oversize frame: dropped by the link
+    segment_.pollSlaves(now);
+    return okStatus();
+  }
+  if (*received == 0) {
+    segment_.pollSlaves(now);
+    return okStatus();
+  }
+  ++counters_.framesReceived;
+  Bytes frame(buffer_.data(), *received);
+  FrameOutcome outcome = segment_.processFrame(frame, now);
+  if (!outcome.delivered) {
+    ++counters_.framesDropped;
+    return okStatus();
+  }
+  counters_.lastRoundTrip = outcome.returnTime - now;
+  if (options_.paced) {
+    while (clock_.now() < outcome.returnTime) {
+      // Round trips are microseconds: waiting actively keeps the answer on time.
+    }
+  }
+  if (auto sent = link_.send(frame); !sent.ok()) {
+    ++counters_.sendErrors;
+  } else {
+    ++counters_.framesAnswered;
+  }
+  // The firmware reacts after the frame has passed, as on hardware.
+  segment_.pollSlaves(clock_.now());
+  return okStatus();
+}
+
+Status NetworkServer::run(const std::function<bool()>& stop) {
+  while (!stop()) {
+    ECSIM_TRY(step());
+  }
+  return okStatus();
+}
+
+}  // namespace ecsim::topology

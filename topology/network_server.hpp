@@ -1,0 +1,54 @@
+// Serves a Segment on a Link: every EtherCAT frame the master sends is carried through the
+// simulated network and sent back, processed, on the same link. Malformed frames are dropped
+// and counted, never answered. In paced mode a frame goes back only when its modelled return
+// time has come on the injected clock, so an external master sees realistic round trips.
+#pragma once
+
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+
+#include "link/link.hpp"
+#include "protocol/ethernet.hpp"
+#include "protocol/time.hpp"
+#include "topology/segment.hpp"
+
+namespace ecsim::topology {
+
+struct ServerOptions {
+  bool paced{false};
+  // How long one step waits for a frame before running the slaves' firmware anyway.
+  std::chrono::nanoseconds idleWait{std::chrono::milliseconds(1)};
+};
+
+struct ServerCounters {
+  std::uint64_t framesReceived{0};
+  std::uint64_t framesAnswered{0};
+  std::uint64_t framesDropped{0};  // malformed: not answered
+  std::uint64_t receiveErrors{0};
+  std::uint64_t sendErrors{0};
+  SimTime lastRoundTrip{0};
+};
+
+class NetworkServer {
+ public:
+  NetworkServer(Link& link, Segment& segment, const Clock& clock, ServerOptions options = {});
+
+  // Waits up to the idle wait for one frame, processes and answers it, runs the firmware.
+  Status step();
+  // Steps until stop() returns true.
+  Status run(const std::function<bool()>& stop);
+
+  const ServerCounters& counters() const { return counters_; }
+
+ private:
+  Link& link_;
+  Segment& segment_;
+  const Clock& clock_;
+  ServerOptions options_;
+  ServerCounters counters_{};
+  std::array<std::uint8_t, kMaxFrameSize> buffer_{};
+};
+
+}  // namespace ecsim::topology
