@@ -1,0 +1,134 @@
+// Small helpers over tinyxml2 shared by the config readers: errors that name file and line,
+// typed text/attribute access in ESI number syntax, and the well-formedness checks tinyxml2
+// leaves out. Internal to config/.
+#pragma once
+
+#include <tinyxml2.h>
+
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <type_traits>
+#include <vector>
+
+#include "config/esi.hpp"
+#include "protocol/result.hpp"
+
+namespace ecsim::xml {
+
+using Element = tinyxml2::XMLElement;
+
+// Iterates the child elements named `name` (all children when name is null).
+class Children {
+ public:
+  Children(const Element* parent, const char* name) : parent_(parent), name_(name) {}
+  class Iterator {
+   public:
+    Iterator(const Element* e, const char* name) : e_(e), name_(name) {}
+    const Element* operator*() const { return e_; }
+    Iterator& operator++() {
+      e_ = e_->NextSiblingElement(name_);
+      return *this;
+    }
+    bool operator!=(const Iterator& other) const { return e_ != other.e_; }
+
+   private:
+    const Element* e_;
+    const char* name_;
+  };
+  Iterator begin() const {
+    return {parent_ == nullptr ? nullptr : parent_->FirstChildElement(name_), name_};
+  }
+  Iterator end() const { return {nullptr, name_}; }
+
+ private:
+  const Element* parent_;
+  const char* name_;
+};
+
+// Error context: the file name used in messages ("<file>, line <n>: <what>").
+class Context {
+ public:
+  explicit Context(std::string file) : file_(std::move(file)) {}
+  const std::string& file() const { return file_; }
+
+  Error error(int line, std::string_view message) const {
+    return makeError(ErrorCode::kParse,
+                     file_ + ", line " + std::to_string(line) + ": " + std::string(message));
+  }
+  Error error(const Element* e, std::string_view message) const {
+    return error(e == nullptr ? 0 : e->GetLineNum(), message);
+  }
+
+ private:
+  std::string file_;
+};
+
+// Element text (first text or CDATA child), trimmed; empty when absent.
+std::string_view text(const Element* e);
+// Text of the first child element `name`, trimmed; empty when absent.
+std::string_view childText(const Element* parent, const char* name);
+// All <Name LcId=".."> (or another tag) children as local texts.
+std::vector<EsiLocalText> localTexts(const Element* parent, const char* name);
+
+// Checks the value range of an integer parsed from `what` at element `e`.
+template <typename T>
+Result<T> narrow(const Context& ctx, const Element* e, std::string_view what, std::string_view raw,
+                 std::int64_t value) {
+  if (value < static_cast<std::int64_t>(std::numeric_limits<T>::min()) ||
+      (value > 0 && static_cast<std::uint64_t>(value) >
+                        static_cast<std::uint64_t>(std::numeric_limits<T>::max()))) {
+    return ctx.error(e, std::string(what) + " value '" + std::string(raw) + "' out of range");
+  }
+  return static_cast<T>(value);
+}
+
+template <typename T>
+Result<T> parseNumber(const Context& ctx, const Element* e, std::string_view what,
+                      std::string_view raw) {
+  auto value = parseEsiInteger(raw);
+  if (!value.ok()) {
+    return ctx.error(e, std::string(what) + ": " + value.error().context);
+  }
+  return narrow<T>(ctx, e, what, raw, *value);
+}
+
+// Number in the text of child `name`; nullopt when the child is absent or empty.
+template <typename T>
+Result<std::optional<T>> childNumber(const Context& ctx, const Element* parent, const char* name) {
+  const Element* child = parent->FirstChildElement(name);
+  if (child == nullptr || text(child).empty()) return std::optional<T>{};
+  ECSIM_ASSIGN_OR_RETURN(T value, parseNumber<T>(ctx, child, name, text(child)));
+  return std::optional<T>{value};
+}
+
+// Number in attribute `name`; nullopt when absent or empty.
+template <typename T>
+Result<std::optional<T>> attrNumber(const Context& ctx, const Element* e, const char* name) {
+  const char* raw = e->Attribute(name);
+  if (raw == nullptr || trimEsiText(raw).empty()) return std::optional<T>{};
+  ECSIM_ASSIGN_OR_RETURN(T value, parseNumber<T>(ctx, e, std::string("attribute ") + name, raw));
+  return std::optional<T>{value};
+}
+
+// Boolean attribute; `fallback` when absent.
+Result<bool> attrBool(const Context& ctx, const Element* e, const char* name, bool fallback);
+
+// Hex bytes in the text of child `name`; empty when absent.
+Result<std::vector<std::uint8_t>> childHex(const Context& ctx, const Element* parent,
+                                           const char* name);
+
+// tinyxml2 accepts an '&' that starts no entity reference ("AB&T"); XML does not. Reports the
+// first one (text and attribute values; comments, CDATA and processing instructions are
+// skipped) with its line.
+Status checkEntityReferences(std::string_view xml, const Context& ctx);
+
+// Encoding named in the XML declaration (UTF-8 when absent).
+EsiEncoding declaredEncoding(std::string_view xml);
+
+// Parses `xml` into `doc` with the checks above; errors name file and line.
+Status parseDocument(std::string_view xml, const Context& ctx, tinyxml2::XMLDocument& doc);
+
+}  // namespace ecsim::xml
