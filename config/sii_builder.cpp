@@ -199,6 +199,22 @@ std::uint8_t coeDataTypeCode(std::string_view esiTypeName) {
   }
   if (name == "BIT6") return 0x35;
   if (name == "BIT7") return 0x36;
+  // Sized spellings some generators write (Orbita2d.xml: UINT16, UINT8).
+  static constexpr std::array<Code, 10> kSized = {{
+      {"INT8", 0x02},
+      {"INT16", 0x03},
+      {"INT32", 0x04},
+      {"UINT8", 0x05},
+      {"UINT16", 0x06},
+      {"UINT32", 0x07},
+      {"REAL32", 0x08},
+      {"REAL64", 0x11},
+      {"INT64", 0x15},
+      {"UINT64", 0x1B},
+  }};
+  for (const auto& c : kSized) {
+    if (c.name == name) return c.code;
+  }
   return 0;
 }
 
