@@ -161,8 +161,14 @@ void Esc::loadFromSii() {
 
 // ---- ECAT side ------------------------------------------------------------------------------
 
-void Esc::processDatagram(DatagramView d, SimTime localTime) {
+SimTime Esc::systemTime(SimTime time) const {
+  return dc_.localTime(time) + static_cast<SimTime>(reg64(reg::kSystemTimeOffset.address));
+}
+
+void Esc::processDatagram(DatagramView d, SimTime time) {
   lastWkcIncrement_ = 0;
+  now_ = time;
+  localNow_ = dc_.localTime(time);
   if (!isKnownCommand(d.rawCommand())) return;  // unknown command: forwarded untouched
   const Command cmd = d.command();
   const std::uint16_t len = d.length();
@@ -200,8 +206,7 @@ void Esc::processDatagram(DatagramView d, SimTime localTime) {
       if (cmd == Command::kArmw || cmd == Command::kFrmw) {
         // Read at the addressed slave, write at every other one (datasheet Table 7).
         if (addressed) {
-          refreshVolatile(ado, static_cast<std::uint16_t>(std::min<std::uint32_t>(end, 0xFFFF)),
-                          localTime);
+          refreshVolatile(ado, static_cast<std::uint16_t>(std::min<std::uint32_t>(end, 0xFFFF)));
           readMemory(ado, d.data(), false);
           inc = 1;
         } else if (writeMemory(ado, d.data())) {
@@ -213,8 +218,7 @@ void Esc::processDatagram(DatagramView d, SimTime localTime) {
       ++counters_.datagramsAddressed;
       CommandAccess access = commandAccess(cmd);
       if (access.read) {
-        refreshVolatile(ado, static_cast<std::uint16_t>(std::min<std::uint32_t>(end, 0xFFFF)),
-                        localTime);
+        refreshVolatile(ado, static_cast<std::uint16_t>(std::min<std::uint32_t>(end, 0xFFFF)));
         // Read-write commands: the data read is the memory before the write.
         if (access.write) {
           std::copy(d.data().begin(), d.data().end(), scratch_.begin());
@@ -226,7 +230,7 @@ void Esc::processDatagram(DatagramView d, SimTime localTime) {
         }
       } else if (access.write) {
         if (ado <= reg::kReceiveTimePort0.address && end > reg::kReceiveTimePort0.address) {
-          latchReceiveTimes(localTime);
+          latchReceiveTimes();
         }
         inc = writeMemory(ado, d.data()) ? 1 : 0;
       }
@@ -516,18 +520,27 @@ void Esc::writeRegisters(std::uint16_t address, ConstBytes data) {
   }
   if (overlaps(begin, end, reg::kSystemTime.address, reg::kSystemTime.width)) {
     // Written system time is compared with the local copy; the difference feeds the drift
-    // control loop (datasheet section I §9.1.3). 0x092C: bit 31 set = local copy smaller.
-    SimTime local = static_cast<SimTime>(reg64(reg::kSystemTime.address));
-    std::uint64_t written = 0;
+    // control loop (datasheet section I §9.1.3). A 32-bit write compares the low 32 bits.
+    // 0x092C: bit 31 set = local copy smaller than the received time.
+    const SimTime local = localNow_ + static_cast<SimTime>(reg64(reg::kSystemTimeOffset.address));
+    std::uint64_t written = static_cast<std::uint64_t>(local);
     for (std::uint32_t i = 0; i < 8; ++i) {
       std::uint32_t a = reg::kSystemTime.address + i;
-      std::uint8_t byte = (a >= begin && a < end) ? data[a - begin] : memory_[a];
-      written |= static_cast<std::uint64_t>(byte) << (8 * i);
+      if (a >= begin && a < end) {
+        written = (written & ~(0xFFull << (8 * i))) |
+                  (static_cast<std::uint64_t>(data[a - begin]) << (8 * i));
+      }
     }
-    std::int64_t diff = local - static_cast<std::int64_t>(written);
-    std::uint32_t mag =
+    const SimTime received =
+        static_cast<SimTime>(written) + static_cast<SimTime>(reg32(reg::kSystemTimeDelay.address));
+    const std::int64_t diff = dc_.onSystemTimeWrite(
+        now_, local, received, memory_[reg::kSystemTimeDifferenceFilterDepth.address] & 0x0F);
+    const std::uint32_t mag =
         static_cast<std::uint32_t>(std::min<std::int64_t>(diff < 0 ? -diff : diff, 0x7FFFFFFF));
     writeLe32(memory_, reg::kSystemTimeDifference.address, diff < 0 ? (mag | 0x80000000u) : mag);
+  }
+  if (overlaps(begin, end, reg::kSpeedCounterStart.address, reg::kSpeedCounterStart.width)) {
+    dc_.resetControl();
   }
   if (overlaps(begin, end, reg::kFmmuBase, reg::kFmmuSize * reg::kMaxFmmus)) rebuildFmmuCache();
   if (overlaps(begin, end, reg::kSmBase, reg::kSmSize * reg::kMaxSyncManagers)) {
@@ -554,28 +567,27 @@ void Esc::smActivationChanged(unsigned s) {
   memory_[base + reg::sm::kStatus.address] = 0;
 }
 
-void Esc::refreshVolatile(std::uint16_t begin, std::uint16_t end, SimTime localTime) {
+void Esc::refreshVolatile(std::uint16_t begin, std::uint16_t end) {
   if (overlaps(begin, end, reg::kSystemTime.address, reg::kSystemTime.width)) {
     auto offset = static_cast<std::int64_t>(reg64(reg::kSystemTimeOffset.address));
-    writeLe64(memory_, reg::kSystemTime.address, static_cast<std::uint64_t>(localTime + offset));
+    writeLe64(memory_, reg::kSystemTime.address, static_cast<std::uint64_t>(localNow_ + offset));
   }
 }
 
-void Esc::completeReceiveTimeLatch(const std::array<SimTime, 4>& localTimes,
-                                   std::uint8_t portMask) {
+void Esc::completeReceiveTimeLatch(const std::array<SimTime, 4>& times, std::uint8_t portMask) {
   if (!latchArmed_) return;
   latchArmed_ = false;
   for (unsigned p = 0; p < 4; ++p) {
     if ((portMask & (1u << p)) != 0) {
-      writeLe32(memory_, reg::receiveTime(p), static_cast<std::uint32_t>(localTimes[p]));
+      writeLe32(memory_, reg::receiveTime(p), static_cast<std::uint32_t>(dc_.localTime(times[p])));
     }
   }
 }
 
-void Esc::latchReceiveTimes(SimTime localTime) {
+void Esc::latchReceiveTimes() {
   latchArmed_ = true;
   writeLe64(memory_, reg::kReceiveTimeEcatProcessingUnit.address,
-            static_cast<std::uint64_t>(localTime));
+            static_cast<std::uint64_t>(localNow_));
   events_.dcLatched = true;
 }
 

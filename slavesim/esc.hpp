@@ -18,6 +18,7 @@
 #include "protocol/frame.hpp"
 #include "protocol/registers.hpp"
 #include "protocol/time.hpp"
+#include "slavesim/dc_clock.hpp"
 #include "slavesim/esc_type.hpp"
 
 namespace ecsim::slavesim {
@@ -50,19 +51,26 @@ class Esc {
   const EscType& type() const { return type_; }
 
   // ---- ECAT side ------------------------------------------------------------------------
-  // Processes one datagram at this ESC. localTime is the ESC's local clock when the datagram's
-  // first byte passes the processing unit. Modifies data, ADP and WKC in place.
-  void processDatagram(DatagramView datagram, SimTime localTime);
+  // Processes one datagram at this ESC. `time` is the simulation (global) time at which the
+  // datagram's first byte passes the processing unit; the ESC reads its own local clock from
+  // it. Modifies data, ADP and WKC in place.
+  void processDatagram(DatagramView datagram, SimTime time);
   // Working counter increment this ESC gave the last processed datagram (for tests/tracing).
   std::uint16_t lastWkcIncrement() const { return lastWkcIncrement_; }
   // A new frame starts passing (resets per-frame state such as the ARMW reference).
   void beginFrame() { ++counters_.framesSeen; }
 
   // DC: a write to 0x0900 arms the receive-time latch; when the frame has passed, the topology
-  // hands over the local times its first bit arrived at each port (mask: ports it arrived at)
-  // and they are stored in 0x0900-0x090F.
+  // hands over the simulation times its first bit arrived at each port (mask: ports it
+  // arrived at) and their local-clock values are stored in 0x0900-0x090F.
   bool receiveTimeLatchArmed() const { return latchArmed_; }
-  void completeReceiveTimeLatch(const std::array<SimTime, 4>& localTimes, std::uint8_t portMask);
+  void completeReceiveTimeLatch(const std::array<SimTime, 4>& times, std::uint8_t portMask);
+
+  // The ESC's local clock (oscillator offset and drift, and the DC control loop).
+  DcClock& dcClock() { return dc_; }
+  const DcClock& dcClock() const { return dc_; }
+  // System time (0x0910 as a read would give it) at simulation time `time`.
+  SimTime systemTime(SimTime time) const;
 
   // ---- PDI side (firmware) --------------------------------------------------------------
   std::uint16_t alControl() const { return reg16(reg::kAlControl.address); }
@@ -165,13 +173,13 @@ class Esc {
   bool readRam(std::uint16_t address, Bytes out, bool orInto, int sm);
   bool writeRam(std::uint16_t address, ConstBytes data, int sm);
   void writeRegisters(std::uint16_t address, ConstBytes data);
-  void refreshVolatile(std::uint16_t begin, std::uint16_t end, SimTime localTime);
+  void refreshVolatile(std::uint16_t begin, std::uint16_t end);
   void siiCommand(std::uint16_t control);
   void smActivationChanged(unsigned sm);
   int smCovering(std::uint16_t address) const;
   // Logical addressing through FMMUs. Returns {readHit, writeHit}.
   std::pair<bool, bool> processLogical(DatagramView d, bool doRead, bool doWrite);
-  void latchReceiveTimes(SimTime localTime);
+  void latchReceiveTimes();
 
   const EscType type_;
   std::vector<std::uint8_t> memory_;    // registers 0x0000-0x0FFF + process RAM
@@ -182,6 +190,9 @@ class Esc {
   std::vector<std::uint8_t> lastMailboxResponse_;
   std::size_t lastMailboxResponseSize_{0};
   bool latchArmed_{false};
+  DcClock dc_;
+  SimTime now_{0};       // simulation time of the datagram being processed
+  SimTime localNow_{0};  // local time of the datagram being processed
   EscEvents events_{};
   EscCounters counters_{};
   struct ActiveFmmu {

@@ -18,7 +18,6 @@ std::size_t Segment::addSlave(std::unique_ptr<slavesim::Slave> slave) {
   slaves_.push_back(std::move(slave));
   links_.push_back({});
   linkUp_.push_back({true, true, true, true});
-  clocks_.push_back({});
   delays_.push_back({type.processingDelayNs, type.forwardingDelayNs});
   parent_.push_back(static_cast<int>(slaves_.size() - 1));
   arrival_.push_back({});
@@ -146,7 +145,7 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
       esc.beginFrame();
       for (std::size_t i = 0; i < count; ++i) {
         SimTime at = t + headerLead + static_cast<SimTime>(offsets[i]) * nsPerByte;
-        esc.processDatagram(datagrams_[i], clocks_[s].localTime(at));
+        esc.processDatagram(datagrams_[i], at);
       }
       viaEpu = true;
     }
@@ -184,9 +183,7 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
   for (std::size_t i = 0; i < slaves_.size(); ++i) {
     auto& esc = slaves_[i]->esc();
     if (esc.receiveTimeLatchArmed()) {
-      std::array<SimTime, kPortCount> local{};
-      for (unsigned p = 0; p < kPortCount; ++p) local[p] = clocks_[i].localTime(arrival_[i][p]);
-      esc.completeReceiveTimeLatch(local, arrivalMask_[i]);
+      esc.completeReceiveTimeLatch(arrival_[i], arrivalMask_[i]);
     }
   }
   // The master has the frame when its last bit is in: wire footprint of the frame itself

@@ -38,16 +38,6 @@ struct TimingModel {
   double cableNsPerMetre{5.0};
 };
 
-// A slave's free-running local clock: local = t + offset + t * drift (ppm). Real ESC clocks
-// are 25 ppm-class quartz oscillators; defaults are an ideal clock.
-struct ClockModel {
-  SimTime offset{0};
-  double driftPpm{0.0};
-  SimTime localTime(SimTime t) const {
-    return t + offset + static_cast<SimTime>(static_cast<double>(t) * driftPpm * 1e-6);
-  }
-};
-
 struct FrameOutcome {
   bool delivered{false};  // false: dropped (malformed or lost)
   SimTime returnTime{0};  // when the last bit is back at the master
@@ -73,8 +63,10 @@ class Segment {
   // Wires slaves 0..n-1 as a line (port 1 of each to port 0 of the next).
   void wireLine(double metres = 1.0);
   void setMasterCable(double metres) { masterCable_ = metres; }
-  void setClock(std::size_t slave, const ClockModel& clock) { clocks_[slave] = clock; }
-  const ClockModel& clock(std::size_t slave) const { return clocks_[slave]; }
+  // A slave's oscillator: local time at simulation time 0 and drift in ppm (+ runs fast).
+  void setClock(std::size_t slave, SimTime offset, double driftPpm) {
+    slaves_[slave]->esc().dcClock().configure(offset, driftPpm);
+  }
   // ESC delays in ns: through the processing unit (port 0 -> next port) and forwarding
   // (any other port -> next port). Defaults come from the slave's ESC type.
   void setDelays(std::size_t slave, SimTime processing, SimTime forwarding);
@@ -108,7 +100,6 @@ class Segment {
   std::vector<std::unique_ptr<slavesim::Slave>> slaves_;
   std::vector<std::array<PortLink, kPortCount>> links_;
   std::vector<std::array<bool, kPortCount>> linkUp_;
-  std::vector<ClockModel> clocks_;
   std::vector<std::array<SimTime, 2>> delays_;  // processing, forwarding
   std::vector<int> parent_;                     // union-find for the tree check
   std::vector<std::array<SimTime, kPortCount>> arrival_;

@@ -1,0 +1,50 @@
+// The free-running local clock of an ESC and its drift control loop (ESC datasheet section I
+// §9.1: local time from the ESC's own oscillator; system time = local time + offset 0x0920;
+// a write of the reference system time to 0x0910 (ARMW/FRMW, or BWR/FPWR) is compared with
+// the local copy, and the filtered difference slows down or speeds up the local clock).
+//
+// The clock is a piecewise-linear function of global (simulation) time: local(t) =
+// base + (t - tBase) * (1 + rate), where rate = physical drift + control correction. It is a
+// pure function between corrections, so times can be asked out of order within a frame.
+#pragma once
+
+#include <cstdint>
+
+#include "protocol/time.hpp"
+
+namespace ecsim::slavesim {
+
+class DcClock {
+ public:
+  // offset: local time at global time 0; driftPpm: the oscillator's error (+ runs fast).
+  void configure(SimTime offset, double driftPpm);
+
+  SimTime localTime(SimTime global) const;
+  // Global time at which the local clock reads `local` (inverse of localTime).
+  SimTime globalTime(SimTime local) const;
+
+  // A system time was written to 0x0910 at global time `global`. `localSystemTime` is the
+  // ESC's own system time (local + offset) at that moment, `received` the written value plus
+  // the propagation delay 0x0928. Runs one step of the control loop and returns the
+  // difference local - received (what 0x092C reports).
+  std::int64_t onSystemTimeWrite(SimTime global, SimTime localSystemTime, SimTime received,
+                                 unsigned filterDepth);
+  // 0x0930 write: resets the control loop (speed counter start).
+  void resetControl();
+
+  double ratePpm() const { return (driftPpb_ + correctionPpb_) * 1e-3; }
+  double correctionPpm() const { return correctionPpb_ * 1e-3; }
+
+ private:
+  void rebase(SimTime global);
+
+  SimTime tBase_{0};
+  SimTime localBase_{0};
+  double driftPpb_{0.0};
+  double correctionPpb_{0.0};
+  double integralPpb_{0.0};
+  SimTime lastWrite_{0};
+  bool haveLastWrite_{false};
+};
+
+}  // namespace ecsim::slavesim
