@@ -25,6 +25,11 @@ std::string categoryName(std::uint16_t type) {
   return name + " (" + hex(type) + ")";
 }
 
+// Raw categories the encoder writes before STRINGS (where real dumps have them).
+bool leadingRawCategory(std::uint16_t type) {
+  return isDeviceSpecificCategory(type) || isVendorCategory(type);
+}
+
 bool isOtherHeaderWord(std::size_t address) {
   return (address >= 0x10 && address <= 0x13) || (address >= 0x1D && address <= 0x3D);
 }
@@ -275,6 +280,11 @@ Result<SiiImage> SiiImage::parseImpl(ConstBytes bytes, bool strict) {
       break;
     }
   }
+  // Raw categories in the order encodeSii() writes them (device-specific and vendor ones
+  // first, the rest after SYNCM), so that parse(encode(contents)) == contents.
+  auto& raw = image.contents_.otherCategories;
+  std::stable_partition(raw.begin(), raw.end(),
+                        [](const SiiRawCategory& c) { return leadingRawCategory(c.type); });
   return image;
 }
 
@@ -440,10 +450,6 @@ class Writer {
   std::vector<std::uint8_t>& out_;
   std::size_t lengthAt_{0};
 };
-
-bool leadingRawCategory(std::uint16_t type) {
-  return isDeviceSpecificCategory(type) || isVendorCategory(type);
-}
 
 Status checkEncodable(const SiiContents& c) {
   if (c.strings.size() > 255) {

@@ -272,7 +272,9 @@ struct SiiContents {
   std::vector<SiiPdo> txPdos;  // inputs (slave -> master)
   std::vector<SiiPdo> rxPdos;  // outputs
   std::vector<SiiDcOpMode> dcOpModes;
-  std::vector<SiiRawCategory> otherCategories;  // in image order
+  // Device-specific (1-9) and vendor (>= 0x0800) ones first, then the others; each group in
+  // image order (the order encodeSii() writes them in).
+  std::vector<SiiRawCategory> otherCategories;
 
   // String by its SII index (1-based); empty for 0 or an index past the table.
   std::string_view string(std::size_t index) const;

@@ -211,6 +211,28 @@ TEST(SiiParse, PdoEntriesPastCategoryIsAnError) {
   EXPECT_NE(pdos.error().context.find("0x1A00"), std::string::npos);
 }
 
+TEST(SiiParse, RawCategoriesComeInEncoderOrder) {
+  // A SyncUnit category before a device-specific one (found by mutating el2828.hex): the
+  // encoder writes device-specific/vendor categories first, so the decoder lists them first.
+  std::vector<std::uint8_t> bytes(sii::kHeaderBytes, 0);
+  writeLe16(bytes, 2 * sii::kWordSize, 1);
+  for (int word : {0x002B, 1, 0xFFF0, 0x0003, 1, 0x1234, 0xFFFF}) {
+    bytes.push_back(static_cast<std::uint8_t>(word));
+    bytes.push_back(static_cast<std::uint8_t>(word >> 8));
+  }
+  auto image = SiiImage::parse(bytes);
+  ASSERT_TRUE(image.ok()) << image.error().message();
+  ASSERT_EQ(image->contents().otherCategories.size(), 2u);
+  EXPECT_EQ(image->contents().otherCategories[0].type, 0x0003);
+  EXPECT_EQ(image->contents().otherCategories[1].type, 0x002B);
+  EXPECT_EQ(image->categories()[0].type, 0x002B);  // the category list keeps image order
+  auto again = encodeSii(image->contents());
+  ASSERT_TRUE(again.ok());
+  auto reparsed = SiiImage::parse(*again);
+  ASSERT_TRUE(reparsed.ok());
+  EXPECT_EQ(reparsed->contents(), image->contents());
+}
+
 TEST(SiiCategoryReader, SkipsNothingAndReportsVendorCategories) {
   auto bytes = encodeSii(sampleContents());
   ASSERT_TRUE(bytes.ok());
