@@ -1,0 +1,168 @@
+#include "config/topology_file.hpp"
+
+#include <fstream>
+#include <sstream>
+
+#include "config/xml_util.hpp"
+
+namespace ecsim {
+namespace {
+
+using xml::Element;
+
+Result<std::pair<std::size_t, unsigned>> parseEndpoint(const xml::Context& ctx, const Element* e,
+                                                       const char* attribute,
+                                                       const TopologyConfig& cfg) {
+  const char* raw = e->Attribute(attribute);
+  if (raw == nullptr) return ctx.error(e, std::string("Link needs attribute '") + attribute + "'");
+  std::string_view text(raw);
+  auto colon = text.rfind(':');
+  if (colon == std::string_view::npos) {
+    return ctx.error(e, std::string(attribute) + " '" + std::string(text) +
+                            "' must be SLAVE:PORT (e.g. Coupler:1)");
+  }
+  auto slave = cfg.findSlave(text.substr(0, colon));
+  if (!slave) {
+    return ctx.error(e,
+                     "unknown slave '" + std::string(text.substr(0, colon)) + "' in " + attribute);
+  }
+  ECSIM_ASSIGN_OR_RETURN(auto port,
+                         xml::parseNumber<std::uint8_t>(ctx, e, attribute, text.substr(colon + 1)));
+  if (port > 3) return ctx.error(e, std::string(attribute) + ": port must be 0..3");
+  return std::make_pair(*slave, static_cast<unsigned>(port));
+}
+
+Result<double> attrDouble(const xml::Context& ctx, const Element* e, const char* name,
+                          double fallback) {
+  const char* raw = e->Attribute(name);
+  if (raw == nullptr) return fallback;
+  double v = 0;
+  if (e->QueryDoubleAttribute(name, &v) != tinyxml2::XML_SUCCESS) {
+    return ctx.error(e, std::string("attribute ") + name + ": '" + raw + "' is not a number");
+  }
+  return v;
+}
+
+Result<TopologySlave> parseSlave(const xml::Context& ctx, const Element* e,
+                                 const std::filesystem::path& folder) {
+  TopologySlave s;
+  s.line = e->GetLineNum();
+  const char* name = e->Attribute("name");
+  if (name == nullptr || std::string_view(name).empty()) {
+    return ctx.error(e, "Slave needs a name attribute");
+  }
+  s.name = name;
+  if (const char* esi = e->Attribute("esi")) s.esiFile = folder / esi;
+  ECSIM_ASSIGN_OR_RETURN(s.productCode, xml::attrNumber<std::uint32_t>(ctx, e, "product"));
+  ECSIM_ASSIGN_OR_RETURN(s.revision, xml::attrNumber<std::uint32_t>(ctx, e, "revision"));
+  if (const char* device = e->Attribute("device")) s.builtin = device;
+  if (s.esiFile.empty() && s.builtin.empty()) s.builtin = "generic";
+  if (!s.esiFile.empty() && !s.productCode) {
+    return ctx.error(e, "Slave '" + s.name + "' names an ESI file but no product code");
+  }
+  if (!s.esiFile.empty() && !s.builtin.empty()) {
+    return ctx.error(e, "Slave '" + s.name + "': give either esi+product or device, not both");
+  }
+  if (const char* esc = e->Attribute("esc")) s.esc = esc;
+  ECSIM_ASSIGN_OR_RETURN(s.processingDelayNs,
+                         xml::attrNumber<std::int64_t>(ctx, e, "processingDelayNs"));
+  ECSIM_ASSIGN_OR_RETURN(s.forwardingDelayNs,
+                         xml::attrNumber<std::int64_t>(ctx, e, "forwardingDelayNs"));
+  if (const Element* clock = e->FirstChildElement("Clock")) {
+    ECSIM_ASSIGN_OR_RETURN(auto offset, xml::attrNumber<std::int64_t>(ctx, clock, "offsetNs"));
+    s.clockOffsetNs = offset.value_or(0);
+    ECSIM_ASSIGN_OR_RETURN(s.driftPpm, attrDouble(ctx, clock, "driftPpm", 0.0));
+    if (s.driftPpm < -1000.0 || s.driftPpm > 1000.0) {
+      return ctx.error(clock, "driftPpm must be within +-1000");
+    }
+  }
+  if (const char* state = e->Attribute("stateFile")) s.stateFile = folder / state;
+  for (const Element* in : xml::Children(e, "Input")) {
+    TopologyInput input;
+    input.line = in->GetLineNum();
+    const char* entry = in->Attribute("entry");
+    if (entry == nullptr) return ctx.error(in, "Input needs entry=\"INDEX:SUB\"");
+    std::string_view text(entry);
+    auto colon = text.find(':');
+    if (colon == std::string_view::npos) return ctx.error(in, "entry must be INDEX:SUB");
+    ECSIM_ASSIGN_OR_RETURN(input.index, xml::parseNumber<std::uint16_t>(ctx, in, "entry index",
+                                                                        text.substr(0, colon)));
+    ECSIM_ASSIGN_OR_RETURN(input.subIndex, xml::parseNumber<std::uint8_t>(ctx, in, "entry subindex",
+                                                                          text.substr(colon + 1)));
+    ECSIM_ASSIGN_OR_RETURN(auto value, xml::attrNumber<std::int64_t>(ctx, in, "value"));
+    if (!value) return ctx.error(in, "Input needs a value");
+    input.value = *value;
+    s.inputs.push_back(input);
+  }
+  return s;
+}
+
+}  // namespace
+
+std::optional<std::size_t> TopologyConfig::findSlave(std::string_view n) const {
+  for (std::size_t i = 0; i < slaves.size(); ++i) {
+    if (slaves[i].name == n) return i;
+  }
+  return std::nullopt;
+}
+
+Result<TopologyConfig> parseTopology(std::string_view text, const std::filesystem::path& file) {
+  xml::Context ctx(file.string());
+  tinyxml2::XMLDocument doc;
+  ECSIM_TRY(xml::parseDocument(text, ctx, doc));
+  const Element* root = doc.RootElement();
+  if (root == nullptr || std::string_view(root->Name()) != "Topology") {
+    return ctx.error(root, "root element must be <Topology>");
+  }
+  TopologyConfig cfg;
+  cfg.file = file;
+  if (const char* name = root->Attribute("name")) cfg.name = name;
+  const std::filesystem::path folder = file.parent_path();
+  if (const Element* master = root->FirstChildElement("Master")) {
+    ECSIM_ASSIGN_OR_RETURN(cfg.masterCableMetres, attrDouble(ctx, master, "cable", 1.0));
+  }
+  for (const Element* e : xml::Children(root, "Slave")) {
+    ECSIM_ASSIGN_OR_RETURN(auto slave, parseSlave(ctx, e, folder));
+    if (cfg.findSlave(slave.name)) return ctx.error(e, "duplicate slave name '" + slave.name + "'");
+    cfg.slaves.push_back(std::move(slave));
+  }
+  if (cfg.slaves.empty()) return ctx.error(root, "topology has no <Slave>");
+  for (const Element* e : xml::Children(root, "Link")) {
+    TopologyLink link;
+    link.line = e->GetLineNum();
+    if (const char* name = e->Attribute("name")) link.name = name;
+    ECSIM_ASSIGN_OR_RETURN(auto from, parseEndpoint(ctx, e, "from", cfg));
+    ECSIM_ASSIGN_OR_RETURN(auto to, parseEndpoint(ctx, e, "to", cfg));
+    link.fromSlave = from.first;
+    link.fromPort = from.second;
+    link.toSlave = to.first;
+    link.toPort = to.second;
+    ECSIM_ASSIGN_OR_RETURN(link.cableMetres, attrDouble(ctx, e, "cable", 1.0));
+    if (link.cableMetres < 0 || link.cableMetres > 100) {
+      return ctx.error(e, "cable length must be 0..100 m (100BASE-TX segment limit)");
+    }
+    cfg.links.push_back(link);
+  }
+  cfg.explicitLinks = !cfg.links.empty();
+  if (!cfg.explicitLinks) {  // a line in the written order, port 1 -> port 0
+    for (std::size_t i = 1; i < cfg.slaves.size(); ++i) {
+      cfg.links.push_back({"", i - 1, 1, i, 0, 1.0, cfg.slaves[i].line});
+    }
+  }
+  for (auto& l : cfg.links) {
+    if (l.name.empty())
+      l.name = cfg.slaves[l.fromSlave].name + ":" + std::to_string(l.fromPort) + "-" +
+               cfg.slaves[l.toSlave].name + ":" + std::to_string(l.toPort);
+  }
+  return cfg;
+}
+
+Result<TopologyConfig> loadTopologyFile(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return makeError(ErrorCode::kNotFound, path.string() + ": cannot open topology file");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return parseTopology(buffer.str(), path);
+}
+
+}  // namespace ecsim

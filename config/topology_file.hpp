@@ -1,0 +1,66 @@
+// Topology files (documented in docs/topology.md): which slaves a simulated network has,
+// which device each one is (a device from an ESI file, or a device of ours), how they are
+// wired port to port with which cable lengths, which ESC and delays they use, their clocks
+// and their initial input values. Read into plain structs; errors name the file and line.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "protocol/result.hpp"
+
+namespace ecsim {
+
+struct TopologyInput {  // an initial input value: object entry and value
+  std::uint16_t index{0};
+  std::uint8_t subIndex{0};
+  std::int64_t value{0};
+  int line{0};
+};
+
+struct TopologySlave {
+  std::string name;
+  // Device: from an ESI file (esiFile + productCode [+ revision]) or a built-in one.
+  std::filesystem::path esiFile;  // resolved against the topology file's folder
+  std::optional<std::uint32_t> productCode;
+  std::optional<std::uint32_t> revision;  // absent: the highest revision in the file
+  std::string builtin;                    // "generic" when no ESI device is named
+  std::string esc{"ET1100"};
+  std::optional<std::int64_t> processingDelayNs;
+  std::optional<std::int64_t> forwardingDelayNs;
+  std::int64_t clockOffsetNs{0};
+  double driftPpm{0.0};
+  std::vector<TopologyInput> inputs;
+  std::filesystem::path stateFile;  // persistent device state (e.g. absolute encoder)
+  int line{0};
+};
+
+struct TopologyLink {
+  std::string name;  // cable name, for --pcap-link and fault injection ("" = auto)
+  std::size_t fromSlave{0};
+  unsigned fromPort{0};
+  std::size_t toSlave{0};
+  unsigned toPort{0};
+  double cableMetres{1.0};
+  int line{0};
+};
+
+struct TopologyConfig {
+  std::string name;
+  std::filesystem::path file;
+  double masterCableMetres{1.0};
+  std::vector<TopologySlave> slaves;  // in the order written; slave 0 is at the master
+  std::vector<TopologyLink> links;    // empty in the file: a line in written order
+  bool explicitLinks{false};
+
+  std::optional<std::size_t> findSlave(std::string_view name) const;
+};
+
+Result<TopologyConfig> parseTopology(std::string_view xml, const std::filesystem::path& file);
+Result<TopologyConfig> loadTopologyFile(const std::filesystem::path& path);
+
+}  // namespace ecsim

@@ -1,0 +1,112 @@
+// Topology files: slaves, devices, wiring, cables, clocks and inputs read into plain structs;
+// every error names the file and the line (docs/topology.md).
+#include "config/topology_file.hpp"
+
+#include <gtest/gtest.h>
+
+namespace ecsim {
+namespace {
+
+const std::filesystem::path kFile = "/some/dir/net.xml";
+
+TEST(TopologyFile, LineWhenNoLinksAreGiven) {
+  auto t = parseTopology(R"(<Topology name="line">
+  <Slave name="A"/>
+  <Slave name="B"/>
+  <Slave name="C"/>
+</Topology>)",
+                         kFile);
+  ASSERT_TRUE(t.ok()) << t.error().message();
+  EXPECT_EQ(t->name, "line");
+  ASSERT_EQ(t->slaves.size(), 3u);
+  EXPECT_EQ(t->slaves[0].builtin, "generic");
+  ASSERT_EQ(t->links.size(), 2u);
+  EXPECT_EQ(t->links[1].fromSlave, 1u);
+  EXPECT_EQ(t->links[1].fromPort, 1u);
+  EXPECT_EQ(t->links[1].toSlave, 2u);
+  EXPECT_EQ(t->links[1].toPort, 0u);
+  EXPECT_EQ(t->links[1].name, "B:1-C:0");
+  EXPECT_FALSE(t->explicitLinks);
+}
+
+TEST(TopologyFile, DevicesWiringClocksAndInputs) {
+  auto t = parseTopology(R"(<Topology>
+  <Master cable="2.5"/>
+  <Slave name="J" esi="../esi/devices.xml" product="#x04622C52" esc="ET1100"
+         processingDelayNs="320" forwardingDelayNs="280"/>
+  <Slave name="DI" esi="../esi/devices.xml" product="0x03F03052" revision="#x00100000">
+    <Clock offsetNs="-1500" driftPpm="42.5"/>
+    <Input entry="#x6000:1" value="1"/>
+  </Slave>
+  <Slave name="Drive" device="generic" stateFile="drive.state"/>
+  <Link name="c1" from="J:3" to="DI:0" cable="10"/>
+  <Link from="J:1" to="Drive:0"/>
+</Topology>)",
+                         kFile);
+  ASSERT_TRUE(t.ok()) << t.error().message();
+  EXPECT_DOUBLE_EQ(t->masterCableMetres, 2.5);
+  const auto& j = t->slaves[0];
+  EXPECT_EQ(j.esiFile, std::filesystem::path("/some/dir/../esi/devices.xml"));
+  EXPECT_EQ(j.productCode, 0x04622C52u);
+  EXPECT_EQ(j.processingDelayNs, 320);
+  EXPECT_EQ(j.forwardingDelayNs, 280);
+  const auto& di = t->slaves[1];
+  EXPECT_EQ(di.revision, 0x00100000u);
+  EXPECT_EQ(di.clockOffsetNs, -1500);
+  EXPECT_DOUBLE_EQ(di.driftPpm, 42.5);
+  ASSERT_EQ(di.inputs.size(), 1u);
+  EXPECT_EQ(di.inputs[0].index, 0x6000);
+  EXPECT_EQ(di.inputs[0].subIndex, 1);
+  EXPECT_EQ(di.inputs[0].value, 1);
+  EXPECT_EQ(t->slaves[2].stateFile, std::filesystem::path("/some/dir/drive.state"));
+  ASSERT_EQ(t->links.size(), 2u);
+  EXPECT_EQ(t->links[0].name, "c1");
+  EXPECT_EQ(t->links[0].fromPort, 3u);
+  EXPECT_DOUBLE_EQ(t->links[0].cableMetres, 10.0);
+  EXPECT_EQ(t->links[1].name, "J:1-Drive:0");
+}
+
+struct BadCase {
+  const char* xml;
+  const char* expect;  // part of the message, including the line
+};
+
+class TopologyFileErrors : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(TopologyFileErrors, NameFileAndLine) {
+  auto t = parseTopology(GetParam().xml, kFile);
+  ASSERT_FALSE(t.ok());
+  EXPECT_NE(t.error().context.find("/some/dir/net.xml"), std::string::npos) << t.error().context;
+  EXPECT_NE(t.error().context.find(GetParam().expect), std::string::npos) << t.error().context;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, TopologyFileErrors,
+    ::testing::Values(
+        BadCase{"<Topology>\n<Slave name=\"A\">\n</Topology>", "line 2"},
+        BadCase{"<Network/>", "root element must be <Topology>"},
+        BadCase{"<Topology>\n</Topology>", "no <Slave>"},
+        BadCase{"<Topology>\n<Slave/>\n</Topology>", "line 2: Slave needs a name"},
+        BadCase{"<Topology>\n<Slave name=\"A\"/>\n<Slave name=\"A\"/>\n</Topology>",
+                "line 3: duplicate slave name"},
+        BadCase{"<Topology>\n<Slave name=\"A\"/>\n<Link from=\"A:1\" to=\"B:0\"/>\n</Topology>",
+                "line 3: unknown slave 'B'"},
+        BadCase{"<Topology>\n<Slave name=\"A\"/>\n<Slave name=\"B\"/>\n<Link from=\"A:7\" "
+                "to=\"B:0\"/>\n</Topology>",
+                "line 4: from: port must be 0..3"},
+        BadCase{"<Topology>\n<Slave name=\"A\" esi=\"x.xml\"/>\n</Topology>",
+                "line 2: Slave 'A' names an ESI file but no product code"},
+        BadCase{"<Topology>\n<Slave name=\"A\">\n<Clock driftPpm=\"fast\"/>\n</Slave>\n</Topology>",
+                "line 3: attribute driftPpm"},
+        BadCase{"<Topology>\n<Slave name=\"A\"/>\n<Slave name=\"B\"/>\n<Link from=\"A:1\" "
+                "to=\"B:0\" cable=\"150\"/>\n</Topology>",
+                "line 4: cable length"}));
+
+TEST(TopologyFile, MissingFileIsAClearError) {
+  auto t = loadTopologyFile("/nonexistent/ecsim/topology.xml");
+  ASSERT_FALSE(t.ok());
+  EXPECT_NE(t.error().context.find("/nonexistent/ecsim/topology.xml"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace ecsim
