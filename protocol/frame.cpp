@@ -41,59 +41,6 @@ std::string_view toString(Command command) {
   return "unknown";
 }
 
-AddressMode addressMode(Command command) {
-  switch (command) {
-    case Command::kAprd:
-    case Command::kApwr:
-    case Command::kAprw:
-    case Command::kArmw:
-      return AddressMode::kAutoIncrement;
-    case Command::kFprd:
-    case Command::kFpwr:
-    case Command::kFprw:
-    case Command::kFrmw:
-      return AddressMode::kConfigured;
-    case Command::kBrd:
-    case Command::kBwr:
-    case Command::kBrw:
-      return AddressMode::kBroadcast;
-    case Command::kLrd:
-    case Command::kLwr:
-    case Command::kLrw:
-      return AddressMode::kLogical;
-    case Command::kNop:
-      return AddressMode::kNone;
-  }
-  return AddressMode::kNone;
-}
-
-CommandAccess commandAccess(Command command) {
-  switch (command) {
-    case Command::kAprd:
-    case Command::kFprd:
-    case Command::kBrd:
-    case Command::kLrd:
-      return {true, false};
-    case Command::kApwr:
-    case Command::kFpwr:
-    case Command::kBwr:
-    case Command::kLwr:
-      return {false, true};
-    case Command::kAprw:
-    case Command::kFprw:
-    case Command::kBrw:
-    case Command::kLrw:
-      return {true, true};
-    // ARMW/FRMW: read at the addressed slave, write at all others (datasheet Table 7).
-    case Command::kArmw:
-    case Command::kFrmw:
-      return {true, true};
-    case Command::kNop:
-      return {false, false};
-  }
-  return {false, false};
-}
-
 DatagramHeader DatagramHeader::decode(ConstBytes b) {
   DatagramHeader h;
   h.command = static_cast<Command>(b[0]);

@@ -47,8 +47,32 @@ constexpr bool isKnownCommand(std::uint8_t raw) {
 std::string_view toString(Command command);
 
 enum class AddressMode : std::uint8_t { kNone, kAutoIncrement, kConfigured, kBroadcast, kLogical };
-AddressMode addressMode(Command command);
-inline bool isLogical(Command c) {
+constexpr AddressMode addressMode(Command command) {
+  switch (command) {
+    case Command::kAprd:
+    case Command::kApwr:
+    case Command::kAprw:
+    case Command::kArmw:
+      return AddressMode::kAutoIncrement;
+    case Command::kFprd:
+    case Command::kFpwr:
+    case Command::kFprw:
+    case Command::kFrmw:
+      return AddressMode::kConfigured;
+    case Command::kBrd:
+    case Command::kBwr:
+    case Command::kBrw:
+      return AddressMode::kBroadcast;
+    case Command::kLrd:
+    case Command::kLwr:
+    case Command::kLrw:
+      return AddressMode::kLogical;
+    case Command::kNop:
+      return AddressMode::kNone;
+  }
+  return AddressMode::kNone;
+}
+constexpr bool isLogical(Command c) {
   return addressMode(c) == AddressMode::kLogical;
 }
 
@@ -57,7 +81,31 @@ struct CommandAccess {
   bool read;
   bool write;
 };
-CommandAccess commandAccess(Command command);
+// ARMW/FRMW: read at the addressed slave, write at all others (datasheet Table 7).
+constexpr CommandAccess commandAccess(Command command) {
+  switch (command) {
+    case Command::kAprd:
+    case Command::kFprd:
+    case Command::kBrd:
+    case Command::kLrd:
+      return {true, false};
+    case Command::kApwr:
+    case Command::kFpwr:
+    case Command::kBwr:
+    case Command::kLwr:
+      return {false, true};
+    case Command::kAprw:
+    case Command::kFprw:
+    case Command::kBrw:
+    case Command::kLrw:
+    case Command::kArmw:
+    case Command::kFrmw:
+      return {true, true};
+    case Command::kNop:
+      return {false, false};
+  }
+  return {false, false};
+}
 
 constexpr std::size_t kEtherCatHeaderSize = 2;
 constexpr std::size_t kDatagramHeaderSize = 10;

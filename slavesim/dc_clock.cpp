@@ -34,13 +34,13 @@ void DcClock::resetControl() {
 SimTime DcClock::localTime(SimTime global) const {
   const double rate = (driftPpb_ + correctionPpb_) * 1e-9;
   const SimTime dt = global - tBase_;
-  return localBase_ + dt + static_cast<SimTime>(std::llround(static_cast<double>(dt) * rate));
+  return localBase_ + dt + static_cast<SimTime>(static_cast<double>(dt) * rate);
 }
 
 SimTime DcClock::globalTime(SimTime local) const {
   const double rate = (driftPpb_ + correctionPpb_) * 1e-9;
   const double dl = static_cast<double>(local - localBase_);
-  return tBase_ + static_cast<SimTime>(std::llround(dl / (1.0 + rate)));
+  return tBase_ + static_cast<SimTime>(dl / (1.0 + rate));
 }
 
 void DcClock::rebase(SimTime global) {

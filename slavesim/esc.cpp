@@ -46,60 +46,72 @@ std::optional<EscType> escTypeByName(std::string_view name) {
   return std::nullopt;
 }
 
+// ECAT write masks of the register space, one byte per register byte: the same for every ESC
+// type this simulator models, so one immutable table is shared by all ESCs (it stays hot in
+// the cache when a frame passes a thousand of them).
+const std::array<std::uint8_t, kRamStart>& ecatWriteMasks() {
+  static const std::array<std::uint8_t, kRamStart> table = [] {
+    std::array<std::uint8_t, kRamStart> masks{};
+    // ECAT write masks (datasheet section II register tables, column "ECAT"). Everything not
+    // listed is read-only for the master.
+    auto allow = [&](std::uint16_t address, std::uint16_t width, std::uint8_t mask = 0xFF) {
+      for (std::uint16_t i = 0; i < width; ++i) masks[address + i] = mask;
+    };
+    allow(reg::kConfiguredStationAddress.address, 2);
+    allow(reg::kRegisterWriteEnable.address, 1, 0x01);
+    allow(reg::kRegisterWriteProtection.address, 1, 0x01);
+    allow(reg::kEscWriteEnable.address, 1, 0x01);
+    allow(reg::kEscWriteProtection.address, 1, 0x01);
+    allow(reg::kEscResetEcat.address, 1);
+    allow(reg::kDlControl.address, 4);
+    allow(reg::kPhysicalRwOffset.address, 2);
+    allow(reg::kAlControl.address, 2);
+    allow(reg::kRunLedOverride.address, 2);
+    allow(reg::kEcatEventMask.address, 2);
+    allow(reg::kErrorCountersBegin, reg::kErrorCountersEnd - reg::kErrorCountersBegin);
+    allow(reg::kWatchdogDivider.address, 2);
+    allow(reg::kWatchdogTimePdi.address, 2);
+    allow(reg::kWatchdogTimeProcessData.address, 2);
+    allow(reg::kWatchdogCounterProcessData.address, 2);
+    allow(reg::kSiiConfiguration.address, 1, 0x03);
+    allow(reg::kSiiControlStatus.address, 1, 0x01);      // write enable
+    allow(reg::kSiiControlStatus.address + 1, 1, 0x07);  // command bits 8-10
+    allow(reg::kSiiAddress.address, 4);
+    allow(reg::kSiiData.address, 8);
+    allow(reg::kMiiControlStatus.address, 6);
+    allow(reg::kMiiEcatAccessState.address, 1, 0x01);
+    allow(reg::kFmmuBase, reg::kFmmuSize * reg::kMaxFmmus);
+    for (unsigned n = 0; n < reg::kMaxSyncManagers; ++n) {
+      std::uint16_t base = reg::smChannel(n);
+      allow(base, 5);                                     // start, length, control
+      allow(base + reg::sm::kActivate.address, 1, 0xC3);  // enable, repeat, latch bits
+    }
+    allow(reg::kReceiveTimePort0.address, 4);  // a write latches, content not changed
+    allow(reg::kSystemTime.address, 8);
+    allow(reg::kSystemTimeOffset.address, 8);
+    allow(reg::kSystemTimeDelay.address, 4);
+    allow(reg::kSpeedCounterStart.address, 2);
+    allow(reg::kSystemTimeDifferenceFilterDepth.address, 3);
+    allow(reg::kCyclicUnitControl.address, 2);
+    allow(reg::kStartTimeCyclicOperation.address, 8);
+    allow(reg::kSync0CycleTime.address, 8);
+    allow(reg::kLatch0Control.address, 2);
+    allow(reg::kDigitalIoOutputData.address, 4);
+    allow(reg::kGeneralPurposeOutputs.address, 8);
+    allow(reg::kUserRam.address, reg::kUserRam.width);
+    return masks;
+  }();
+  return table;
+}
+
 Esc::Esc(const EscType& type, std::vector<std::uint8_t> siiImage)
     : type_(type),
       memory_(kRamStart + static_cast<std::size_t>(type.ramKb) * 1024, 0),
-      writable_(kRamStart, 0),
+      writable_(ecatWriteMasks()),
       buffers_(3 * static_cast<std::size_t>(type.ramKb) * 1024, 0),
       sii_(std::move(siiImage)) {
-  // ECAT write masks (datasheet section II register tables, column "ECAT"). Everything not
-  // listed is read-only for the master.
-  auto allow = [&](std::uint16_t address, std::uint16_t width, std::uint8_t mask = 0xFF) {
-    for (std::uint16_t i = 0; i < width; ++i) writable_[address + i] = mask;
-  };
-  allow(reg::kConfiguredStationAddress.address, 2);
-  allow(reg::kRegisterWriteEnable.address, 1, 0x01);
-  allow(reg::kRegisterWriteProtection.address, 1, 0x01);
-  allow(reg::kEscWriteEnable.address, 1, 0x01);
-  allow(reg::kEscWriteProtection.address, 1, 0x01);
-  allow(reg::kEscResetEcat.address, 1);
-  allow(reg::kDlControl.address, 4);
-  allow(reg::kPhysicalRwOffset.address, 2);
-  allow(reg::kAlControl.address, 2);
-  allow(reg::kRunLedOverride.address, 2);
-  allow(reg::kEcatEventMask.address, 2);
-  allow(reg::kErrorCountersBegin, reg::kErrorCountersEnd - reg::kErrorCountersBegin);
-  allow(reg::kWatchdogDivider.address, 2);
-  allow(reg::kWatchdogTimePdi.address, 2);
-  allow(reg::kWatchdogTimeProcessData.address, 2);
-  allow(reg::kWatchdogCounterProcessData.address, 2);
-  allow(reg::kSiiConfiguration.address, 1, 0x03);
-  allow(reg::kSiiControlStatus.address, 1, 0x01);      // write enable
-  allow(reg::kSiiControlStatus.address + 1, 1, 0x07);  // command bits 8-10
-  allow(reg::kSiiAddress.address, 4);
-  allow(reg::kSiiData.address, 8);
-  allow(reg::kMiiControlStatus.address, 6);
-  allow(reg::kMiiEcatAccessState.address, 1, 0x01);
-  allow(reg::kFmmuBase, reg::kFmmuSize * reg::kMaxFmmus);
-  for (unsigned n = 0; n < reg::kMaxSyncManagers; ++n) {
-    std::uint16_t base = reg::smChannel(n);
-    allow(base, 5);                                     // start, length, control
-    allow(base + reg::sm::kActivate.address, 1, 0xC3);  // enable, repeat, latch bits
-  }
-  allow(reg::kReceiveTimePort0.address, 4);  // a write latches, content not changed
-  allow(reg::kSystemTime.address, 8);
-  allow(reg::kSystemTimeOffset.address, 8);
-  allow(reg::kSystemTimeDelay.address, 4);
-  allow(reg::kSpeedCounterStart.address, 2);
-  allow(reg::kSystemTimeDifferenceFilterDepth.address, 3);
-  allow(reg::kCyclicUnitControl.address, 2);
-  allow(reg::kStartTimeCyclicOperation.address, 8);
-  allow(reg::kSync0CycleTime.address, 8);
-  allow(reg::kLatch0Control.address, 2);
-  allow(reg::kDigitalIoOutputData.address, 4);
-  allow(reg::kGeneralPurposeOutputs.address, 8);
-  allow(reg::kUserRam.address, reg::kUserRam.width);
   lastMailboxResponse_.resize(static_cast<std::size_t>(type.ramKb) * 1024);
+  scratch_.resize(kMaxDatagramLength + 1);
   reset();
 }
 
@@ -108,6 +120,7 @@ void Esc::reset() {
   std::fill(buffers_.begin(), buffers_.end(), 0);
   sm_ = {};
   activeFmmuCount_ = 0;
+  smRangeCount_ = 0;
   lastMailboxResponseSize_ = 0;
   memory_[reg::kType.address] = type_.typeRegister;
   memory_[reg::kRevision.address] = type_.revisionRegister;
@@ -270,18 +283,8 @@ bool Esc::readMemory(std::uint32_t address, Bytes out, bool orInto) {
     }
     // Process RAM: split at SyncManager boundaries.
     auto a16 = static_cast<std::uint16_t>(at);
-    int smIndex = smCovering(a16);
     std::uint32_t limit = std::min(address + size, memEnd);
-    if (smIndex >= 0) {
-      const auto& cfg = smConfig(static_cast<unsigned>(smIndex));
-      limit = std::min<std::uint32_t>(limit, static_cast<std::uint32_t>(cfg.start) + cfg.length);
-    } else {
-      for (unsigned s = 0; s < type_.syncManagers; ++s) {
-        auto cfg = smConfig(s);
-        if (cfg.enabled && cfg.length > 0 && cfg.start > at)
-          limit = std::min<std::uint32_t>(limit, cfg.start);
-      }
-    }
+    int smIndex = smLookup(at, limit);
     std::uint32_t n = limit - at;
     if (readRam(a16, piece.first(n), orInto, smIndex)) any = true;
     at += n;
@@ -309,18 +312,8 @@ bool Esc::writeMemory(std::uint32_t address, ConstBytes data) {
       continue;
     }
     auto a16 = static_cast<std::uint16_t>(at);
-    int smIndex = smCovering(a16);
     std::uint32_t limit = std::min(address + size, memEnd);
-    if (smIndex >= 0) {
-      const auto cfg = smConfig(static_cast<unsigned>(smIndex));
-      limit = std::min<std::uint32_t>(limit, static_cast<std::uint32_t>(cfg.start) + cfg.length);
-    } else {
-      for (unsigned s = 0; s < type_.syncManagers; ++s) {
-        auto cfg = smConfig(s);
-        if (cfg.enabled && cfg.length > 0 && cfg.start > at)
-          limit = std::min<std::uint32_t>(limit, cfg.start);
-      }
-    }
+    int smIndex = smLookup(at, limit);
     std::uint32_t n = limit - at;
     if (writeRam(a16, piece.first(n), smIndex)) any = true;
     at += n;
@@ -328,15 +321,26 @@ bool Esc::writeMemory(std::uint32_t address, ConstBytes data) {
   return any;
 }
 
-int Esc::smCovering(std::uint16_t address) const {
-  for (unsigned s = 0; s < type_.syncManagers; ++s) {
-    std::uint16_t base = reg::smChannel(s);
-    if ((memory_[base + reg::sm::kActivate.address] & reg::sm::kActivateEnable) == 0) continue;
-    std::uint16_t start = readLe16(memory_, base);
-    std::uint16_t length = readLe16(memory_, base + 2);
-    if (length != 0 && address >= start && address < start + length) return static_cast<int>(s);
+int Esc::smLookup(std::uint32_t at, std::uint32_t& limit) const {
+  for (std::uint8_t k = 0; k < smRangeCount_; ++k) {
+    const SmRange& r = smRanges_[k];
+    if (at >= r.start && at < r.end) {
+      limit = std::min(limit, r.end);
+      return r.index;
+    }
+    if (r.start > at) limit = std::min<std::uint32_t>(limit, r.start);
   }
   return -1;
+}
+
+void Esc::rebuildSmCache() {
+  smRangeCount_ = 0;
+  for (unsigned s = 0; s < type_.syncManagers; ++s) {
+    const SmConfig c = smConfig(s);
+    if (!c.enabled || c.length == 0) continue;
+    smRanges_[smRangeCount_++] = {c.start, static_cast<std::uint32_t>(c.start) + c.length,
+                                  static_cast<std::uint8_t>(s)};
+  }
 }
 
 Esc::SmConfig Esc::smConfig(unsigned s) const {
@@ -471,13 +475,26 @@ void Esc::writeRegisters(std::uint16_t address, ConstBytes data) {
   // SM channel registers 0x0800-0x0804 are writable only while the SM is disabled
   // (datasheet section II, SyncManager register description).
   std::array<bool, reg::kMaxSyncManagers> smWasEnabled{};
-  for (unsigned s = 0; s < type_.syncManagers; ++s) {
+  const bool smTouched = overlaps(begin, end, reg::kSmBase, reg::kSmSize * reg::kMaxSyncManagers);
+  for (unsigned s = 0; smTouched && s < type_.syncManagers; ++s) {
     smWasEnabled[s] =
         (memory_[reg::smChannel(s) + reg::sm::kActivate.address] & reg::sm::kActivateEnable) != 0;
   }
   bool errorCounterWrite = false;
   bool lostLinkWrite = false;
-  for (std::uint32_t i = 0; i < data.size(); ++i) {
+  // Fast path (cyclic DC writes, AL control, ...): no register with per-byte special rules.
+  const bool special =
+      smTouched ||
+      overlaps(begin, end, reg::kErrorCountersBegin,
+               reg::kErrorCountersEnd - reg::kErrorCountersBegin) ||
+      overlaps(begin, end, reg::kWatchdogCounterProcessData.address, 2) ||
+      overlaps(begin, end, reg::kReceiveTimePort0.address, reg::kReceiveTimePort0.width);
+  for (std::uint32_t i = 0; !special && i < data.size(); ++i) {
+    const std::uint32_t a = begin + i;
+    const std::uint8_t mask = writable_[a];
+    memory_[a] = static_cast<std::uint8_t>((memory_[a] & ~mask) | (data[i] & mask));
+  }
+  for (std::uint32_t i = 0; special && i < data.size(); ++i) {
     const std::uint32_t a = begin + i;
     std::uint8_t mask = writable_[a];
     if (mask == 0) continue;
@@ -556,6 +573,7 @@ void Esc::writeRegisters(std::uint16_t address, ConstBytes data) {
         events_.mailboxRead = true;  // firmware sees the repeat request toggle
       }
     }
+    rebuildSmCache();
     events_.smConfigChanged = true;
   }
 }

@@ -133,10 +133,23 @@ class Esc {
   std::uint16_t reg16(std::uint16_t address) const { return readLe16(memory_, address); }
   std::uint32_t reg32(std::uint16_t address) const { return readLe32(memory_, address); }
   std::uint64_t reg64(std::uint16_t address) const { return readLe64(memory_, address); }
-  void pdiWrite8(std::uint16_t address, std::uint8_t v) { memory_[address] = v; }
-  void pdiWrite16(std::uint16_t address, std::uint16_t v) { writeLe16(memory_, address, v); }
-  void pdiWrite32(std::uint16_t address, std::uint32_t v) { writeLe32(memory_, address, v); }
-  void pdiWrite64(std::uint16_t address, std::uint64_t v) { writeLe64(memory_, address, v); }
+  // PDI-side register/RAM writes (no ECAT write masks; FMMU/SM caches follow).
+  void pdiWrite8(std::uint16_t address, std::uint8_t v) {
+    memory_[address] = v;
+    afterPdiWrite(address);
+  }
+  void pdiWrite16(std::uint16_t address, std::uint16_t v) {
+    writeLe16(memory_, address, v);
+    afterPdiWrite(address);
+  }
+  void pdiWrite32(std::uint16_t address, std::uint32_t v) {
+    writeLe32(memory_, address, v);
+    afterPdiWrite(address);
+  }
+  void pdiWrite64(std::uint16_t address, std::uint64_t v) {
+    writeLe64(memory_, address, v);
+    afterPdiWrite(address);
+  }
   std::size_t memorySize() const { return memory_.size(); }
 
   // Error counters (0x0300-0x0313), saturating at 0xFF as the datasheet specifies.
@@ -176,15 +189,26 @@ class Esc {
   void refreshVolatile(std::uint16_t begin, std::uint16_t end);
   void siiCommand(std::uint16_t control);
   void smActivationChanged(unsigned sm);
-  int smCovering(std::uint16_t address) const;
+  // The enabled SM covering `at` (or -1); lowers `limit` to where that SM, or the next SM
+  // above `at`, ends or starts, so callers split accesses at SM boundaries.
+  int smLookup(std::uint32_t at, std::uint32_t& limit) const;
+  void rebuildSmCache();
+  void afterPdiWrite(std::uint16_t address) {
+    if (address >= reg::kFmmuBase && address < reg::kFmmuBase + reg::kFmmuSize * reg::kMaxFmmus) {
+      rebuildFmmuCache();
+    } else if (address >= reg::kSmBase &&
+               address < reg::kSmBase + reg::kSmSize * reg::kMaxSyncManagers) {
+      rebuildSmCache();
+    }
+  }
   // Logical addressing through FMMUs. Returns {readHit, writeHit}.
   std::pair<bool, bool> processLogical(DatagramView d, bool doRead, bool doWrite);
   void latchReceiveTimes();
 
   const EscType type_;
-  std::vector<std::uint8_t> memory_;    // registers 0x0000-0x0FFF + process RAM
-  std::vector<std::uint8_t> writable_;  // per register byte: ECAT write mask
-  std::vector<std::uint8_t> buffers_;   // 3-buffer storage, 3 * length per buffered SM
+  std::vector<std::uint8_t> memory_;  // registers 0x0000-0x0FFF + process RAM
+  const std::array<std::uint8_t, reg::kRegisterSpaceEnd>& writable_;  // ECAT write masks
+  std::vector<std::uint8_t> buffers_;  // 3-buffer storage, 3 * length per buffered SM
   std::vector<std::uint8_t> sii_;
   std::array<SmState, reg::kMaxSyncManagers> sm_{};
   std::vector<std::uint8_t> lastMailboxResponse_;
@@ -204,9 +228,16 @@ class Esc {
   };
   void rebuildFmmuCache();
 
+  struct SmRange {
+    std::uint16_t start;
+    std::uint32_t end;  // exclusive
+    std::uint8_t index;
+  };
+  std::array<SmRange, reg::kMaxSyncManagers> smRanges_{};
+  std::uint8_t smRangeCount_{0};
   std::array<ActiveFmmu, reg::kMaxFmmus> activeFmmus_{};
   std::uint8_t activeFmmuCount_{0};
-  std::array<std::uint8_t, kMaxDatagramLength + 1> scratch_{};
+  std::vector<std::uint8_t> scratch_;  // read-write and bit-FMMU staging, one datagram
   std::uint16_t lastWkcIncrement_{0};
 };
 

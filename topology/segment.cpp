@@ -22,6 +22,7 @@ std::size_t Segment::addSlave(std::unique_ptr<slavesim::Slave> slave) {
   parent_.push_back(static_cast<int>(slaves_.size() - 1));
   arrival_.push_back({});
   arrivalMask_.push_back(0);
+  openMask_.push_back(0);
   stack_.reserve(slaves_.size() + 1);
   refreshLinkStatus();
   return slaves_.size() - 1;
@@ -99,6 +100,11 @@ void Segment::refreshLinkStatus() {
       if (open) dl |= reg::dl_status::communication(p);
     }
     esc.pdiWrite16(reg::kDlStatus.address, dl);
+    std::uint8_t mask = 0;
+    for (unsigned p = 0; p < kPortCount; ++p) {
+      if (portOpen(s, p)) mask = static_cast<std::uint8_t>(mask | (1u << p));
+    }
+    openMask_[s] = mask;
   }
 }
 
@@ -152,7 +158,7 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
     const std::uint8_t out = kNextPort[k];
     Visit& top = stack_.back();
     const bool upstream = out == top.entryPort;
-    if (!upstream && !portOpen(s, out)) {
+    if (!upstream && (openMask_[s] & (1u << out)) == 0) {
       k = out;  // closed or unconnected: the ESC loops the frame back internally
       continue;
     }

@@ -104,6 +104,7 @@ class Segment {
   std::vector<int> parent_;                     // union-find for the tree check
   std::vector<std::array<SimTime, kPortCount>> arrival_;
   std::vector<std::uint8_t> arrivalMask_;
+  std::vector<std::uint8_t> openMask_;  // ports a frame leaves through, from refreshLinkStatus
   int findRoot(int i);
   double masterCable_{1.0};
   TimingModel timing_{};
