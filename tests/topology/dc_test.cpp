@@ -134,7 +134,7 @@ TEST_F(Dc, DriftCompensationHoldsDifferenceBelow100ns) {
   }
   EXPECT_LT(worst, 100) << "worst |0x092C| over 10 s";
   for (std::size_t i = 1; i < drift.size(); ++i) {
-    EXPECT_NEAR(seg_.slave(i).esc().dcClock().ratePpm(), 0.0, 0.5)
+    EXPECT_NEAR(seg_.slave(i).esc().dcClock().ratePpm(), 0.0, 2.0)
         << "slave " << i << " clock brought to the reference rate";
   }
 }
