@@ -23,6 +23,7 @@ std::size_t Segment::addSlave(std::unique_ptr<slavesim::Slave> slave) {
   arrival_.push_back({});
   arrivalMask_.push_back(0);
   openMask_.push_back(0);
+  observers_.push_back({});
   stack_.reserve(slaves_.size() + 1);
   refreshLinkStatus();
   return slaves_.size() - 1;
@@ -63,6 +64,15 @@ Status Segment::connect(std::size_t a, unsigned pa, std::size_t b, unsigned pb, 
 void Segment::wireLine(double metres) {
   for (std::size_t i = 1; i < slaves_.size(); ++i) {
     (void)connect(i - 1, 1, i, 0, metres);
+  }
+}
+
+void Segment::setCableObserver(std::size_t slave, unsigned port, CableObserver* observer) {
+  if (slave >= slaves_.size() || port >= kPortCount) return;
+  observers_[slave][port] = observer;
+  anyObserver_ = false;
+  for (const auto& ports : observers_) {
+    for (auto* o : ports) anyObserver_ |= o != nullptr;
   }
 }
 
@@ -137,6 +147,7 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
   for (auto& m : arrivalMask_) m = 0;
   std::uint32_t s = 0;
   std::uint8_t k = 0;
+  notify(0, 0, frame, sendTime, true);
   SimTime t = sendTime + cableDelay(masterCable_);
   stack_.push_back({0, 0, 0});
   arrival_[0][0] = t;
@@ -165,18 +176,24 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
     const SimTime tOut = t + delays_[s][viaEpu ? 0 : 1];
     viaEpu = false;
     if (upstream) {
+      const std::uint8_t entry = top.entryPort;
       stack_.pop_back();
       if (stack_.empty()) {
+        notify(0, 0, frame, tOut, false);
         outcome.firstBitRoundTrip = tOut + cableDelay(masterCable_) - sendTime;
         break;
       }
       Visit& parent = stack_.back();
       const PortLink& l = links_[parent.slave][parent.port];
+      notify(s, entry, frame, tOut, false);
+      notify(parent.slave, parent.port, frame, tOut, false);
       s = parent.slave;
       k = parent.port;
       t = tOut + cableDelay(l.cableMetres);
     } else {
       const PortLink& l = links_[s][out];
+      notify(s, out, frame, tOut, true);
+      notify(static_cast<std::size_t>(l.slave), l.port, frame, tOut, true);
       top.port = out;
       stack_.push_back({static_cast<std::uint32_t>(l.slave), l.port, l.port});
       s = static_cast<std::uint32_t>(l.slave);

@@ -38,6 +38,15 @@ struct TimingModel {
   double cableNsPerMetre{5.0};
 };
 
+// Sees every frame that crosses a cable, as a tap on that cable would: the bytes as they are
+// at that point (processed by the slaves the frame has already passed) and the model time at
+// which the frame's first bit enters the cable.
+class CableObserver {
+ public:
+  virtual ~CableObserver() = default;
+  virtual void onFrame(ConstBytes frame, SimTime time, bool downstream) = 0;
+};
+
 struct FrameOutcome {
   bool delivered{false};  // false: dropped (malformed or lost)
   SimTime returnTime{0};  // when the last bit is back at the master
@@ -63,6 +72,9 @@ class Segment {
   // Wires slaves 0..n-1 as a line (port 1 of each to port 0 of the next).
   void wireLine(double metres = 1.0);
   void setMasterCable(double metres) { masterCable_ = metres; }
+  // Observes the cable at `slave`'s port `port` (both directions); nullptr removes it. The
+  // cable between the master and slave 0 is (0, 0).
+  void setCableObserver(std::size_t slave, unsigned port, CableObserver* observer);
   // A slave's oscillator: local time at simulation time 0 and drift in ppm (+ runs fast).
   void setClock(std::size_t slave, SimTime offset, double driftPpm) {
     slaves_[slave]->esc().dcClock().configure(offset, driftPpm);
@@ -104,7 +116,14 @@ class Segment {
   std::vector<int> parent_;                     // union-find for the tree check
   std::vector<std::array<SimTime, kPortCount>> arrival_;
   std::vector<std::uint8_t> arrivalMask_;
-  std::vector<std::uint8_t> openMask_;  // ports a frame leaves through, from refreshLinkStatus
+  std::vector<std::uint8_t> openMask_;
+  std::vector<std::array<CableObserver*, kPortCount>> observers_;
+  bool anyObserver_{false};
+  void notify(std::size_t slave, unsigned port, Bytes frame, SimTime time, bool downstream) {
+    if (anyObserver_ && observers_[slave][port] != nullptr) {
+      observers_[slave][port]->onFrame(frame, time, downstream);
+    }
+  }  // ports a frame leaves through, from refreshLinkStatus
   int findRoot(int i);
   double masterCable_{1.0};
   TimingModel timing_{};

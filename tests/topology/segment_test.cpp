@@ -109,3 +109,46 @@ TEST(Segment, DcLatchMeasuresTheDownstreamRoundTrip) {
 
 }  // namespace
 }  // namespace ecsim::testing
+
+namespace ecsim::testing {
+namespace {
+
+struct Recorder : topology::CableObserver {
+  struct Seen {
+    std::vector<std::uint8_t> bytes;
+    SimTime time;
+    bool downstream;
+  };
+  std::vector<Seen> seen;
+  void onFrame(ConstBytes frame, SimTime time, bool downstream) override {
+    seen.push_back({std::vector<std::uint8_t>(frame.begin(), frame.end()), time, downstream});
+  }
+};
+
+TEST(SegmentTaps, InnerCableSeesThePartiallyProcessedFrame) {
+  topology::Segment seg;
+  buildLine(seg, 4);
+  seg.setMasterCable(0.0);
+  Recorder master, inner;
+  seg.setCableObserver(0, 0, &master);
+  seg.setCableObserver(2, 0, &inner);  // the cable between slave 1 and slave 2
+  auto r = one(seg, Command::kBrd, phys(0, 0x0000), {0, 0}, 10'000);
+  EXPECT_EQ(r.wkc, 4);
+  ASSERT_EQ(master.seen.size(), 2u);
+  ASSERT_EQ(inner.seen.size(), 2u);
+  const std::size_t wkcAt = 14 + 2 + 10 + 2;
+  EXPECT_EQ(readLe16(master.seen[0].bytes, wkcAt), 0) << "as the master sent it";
+  EXPECT_EQ(readLe16(inner.seen[0].bytes, wkcAt), 2) << "after slaves 0 and 1";
+  EXPECT_TRUE(inner.seen[0].downstream);
+  EXPECT_EQ(readLe16(inner.seen[1].bytes, wkcAt), 4) << "on its way back: all four";
+  EXPECT_FALSE(inner.seen[1].downstream);
+  EXPECT_EQ(readLe16(master.seen[1].bytes, wkcAt), 4);
+  EXPECT_EQ(master.seen[0].time, 10'000);
+  // Downstream on the inner cable: two ESC processing delays and one 1 m cable later.
+  EXPECT_EQ(inner.seen[0].time, 10'000 + 2 * slavesim::kEt1100.processingDelayNs + 5);
+  EXPECT_LT(inner.seen[0].time, inner.seen[1].time);
+  EXPECT_LT(inner.seen[1].time, master.seen[1].time);
+}
+
+}  // namespace
+}  // namespace ecsim::testing

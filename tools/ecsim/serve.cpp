@@ -7,13 +7,13 @@
 #include <string>
 
 #include "link/pcap.hpp"
-#include "link/pcap_tap.hpp"
 #include "link/raw_socket_link.hpp"
 #include "link/signal_flag.hpp"
 #include "link/tap_link.hpp"
 #include "slavesim/generic_slave.hpp"
 #include "tools/ecsim/commands.hpp"
 #include "topology/network_server.hpp"
+#include "topology/pcap_cable_tap.hpp"
 
 namespace ecsim::tools {
 namespace {
@@ -57,10 +57,10 @@ int runServe(const ServeOptions& o) {
   segment.wireLine();
 
   RealClock clock;
-  WallClock wall;
+  // Captures are stamped with model time; model time 0 is mapped to the Unix time now.
+  const SimTime unixOffset = WallClock().now() - clock.now();
   std::optional<PcapWriter> writer;
-  std::unique_ptr<PcapTap> tap;
-  Link* served = link.get();
+  std::optional<topology::PcapCableTap> tap;
   if (!o.pcap.empty()) {
     auto w = PcapWriter::open(o.pcap);
     if (!w.ok()) {
@@ -68,9 +68,10 @@ int runServe(const ServeOptions& o) {
       return 1;
     }
     writer.emplace(std::move(w).value());
-    tap = std::make_unique<PcapTap>(*link, *writer, wall);
-    served = tap.get();
+    tap.emplace(*writer, unixOffset);
+    segment.setCableObserver(0, 0, &*tap);
   }
+  Link* served = link.get();
 
   topology::ServerOptions options;
   options.paced = o.paced;
