@@ -4,7 +4,8 @@
 
 namespace ecsim::slavesim {
 
-std::unique_ptr<Slave> makeGenericSlave(const std::string& name, std::uint32_t serial) {
+std::unique_ptr<Slave> makeGenericSlave(const std::string& name, std::uint32_t serial,
+                                        const EscType& esc) {
   SiiContents c;
   c.config.pdiControl = 0x0100;  // no PDI, ESC configuration: enhanced link detection off
   c.identity = {kEcsimVendorId, kGenericProductCode, 0x00010000, serial};
@@ -19,7 +20,7 @@ std::unique_ptr<Slave> makeGenericSlave(const std::string& name, std::uint32_t s
   // The contents above always fit in 2 kbit; an error here is a programming error.
   std::vector<std::uint8_t> bytes =
       image.ok() ? std::move(image).value() : std::vector<std::uint8_t>(256, 0xFF);
-  return std::make_unique<Slave>(name, kEt1100, std::move(bytes), SlaveProfile{});
+  return std::make_unique<Slave>(name, esc, std::move(bytes), SlaveProfile{});
 }
 
 }  // namespace ecsim::slavesim

@@ -14,6 +14,7 @@ namespace ecsim::slavesim {
 inline constexpr std::uint32_t kEcsimVendorId = 0x00000E5C;  // placeholder id for our devices
 inline constexpr std::uint32_t kGenericProductCode = 0x00010001;
 
-std::unique_ptr<Slave> makeGenericSlave(const std::string& name, std::uint32_t serial);
+std::unique_ptr<Slave> makeGenericSlave(const std::string& name, std::uint32_t serial,
+                                        const EscType& esc = kEt1100);
 
 }  // namespace ecsim::slavesim

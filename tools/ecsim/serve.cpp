@@ -6,12 +6,14 @@
 #include <optional>
 #include <string>
 
+#include "config/topology_file.hpp"
 #include "link/pcap.hpp"
 #include "link/raw_socket_link.hpp"
 #include "link/signal_flag.hpp"
 #include "link/tap_link.hpp"
 #include "slavesim/generic_slave.hpp"
 #include "tools/ecsim/commands.hpp"
+#include "topology/network_builder.hpp"
 #include "topology/network_server.hpp"
 #include "topology/pcap_cable_tap.hpp"
 
@@ -19,6 +21,8 @@ namespace ecsim::tools {
 namespace {
 
 struct ServeOptions {
+  std::string topology;
+  std::vector<std::string> pcapLinks;  // NAME=FILE
   std::string iface;
   std::string tap;
   std::string netns;
@@ -50,26 +54,59 @@ int runServe(const ServeOptions& o) {
     link = std::make_unique<TapLink>(std::move(tap).value());
   }
 
-  topology::Segment segment;
-  for (unsigned i = 0; i < o.slaves; ++i) {
-    segment.addSlave(slavesim::makeGenericSlave(fmt::format("Slave{}", i + 1), i + 1));
+  topology::Network network;
+  if (!o.topology.empty()) {
+    auto config = loadTopologyFile(o.topology);
+    if (!config.ok()) {
+      fmt::print(stderr, "ecsim serve: {}\n", config.error().message());
+      return 1;
+    }
+    auto built = topology::buildNetwork(*config);
+    if (!built.ok()) {
+      fmt::print(stderr, "ecsim serve: {}\n", built.error().message());
+      return 1;
+    }
+    network = std::move(built).value();
+  } else {
+    network.segment = std::make_unique<topology::Segment>();
+    for (unsigned i = 0; i < o.slaves; ++i) {
+      network.segment->addSlave(slavesim::makeGenericSlave(fmt::format("Slave{}", i + 1), i + 1));
+    }
+    network.segment->wireLine();
+    network.cables.push_back({"master", 0, 0});
   }
-  segment.wireLine();
+  topology::Segment& segment = *network.segment;
 
   RealClock clock;
   // Captures are stamped with model time; model time 0 is mapped to the Unix time now.
   const SimTime unixOffset = WallClock().now() - clock.now();
-  std::optional<PcapWriter> writer;
-  std::optional<topology::PcapCableTap> tap;
-  if (!o.pcap.empty()) {
-    auto w = PcapWriter::open(o.pcap);
+  // One capture per observed cable: --pcap is the master's cable, --pcap-link NAME=FILE any.
+  std::vector<std::pair<std::string, std::string>> captures;
+  if (!o.pcap.empty()) captures.emplace_back("master", o.pcap);
+  for (const auto& spec : o.pcapLinks) {
+    auto eq = spec.find('=');
+    if (eq == std::string::npos) {
+      fmt::print(stderr, "ecsim serve: --pcap-link wants NAME=FILE, got '{}'\n", spec);
+      return 2;
+    }
+    captures.emplace_back(spec.substr(0, eq), spec.substr(eq + 1));
+  }
+  std::vector<std::unique_ptr<PcapWriter>> writers;
+  std::vector<std::unique_ptr<topology::PcapCableTap>> taps;
+  for (const auto& [cable, file] : captures) {
+    const topology::CableRef* ref = network.findCable(cable);
+    if (ref == nullptr) {
+      fmt::print(stderr, "ecsim serve: no cable named '{}' in the topology\n", cable);
+      return 2;
+    }
+    auto w = PcapWriter::open(file);
     if (!w.ok()) {
       fmt::print(stderr, "ecsim serve: {}\n", w.error().message());
       return 1;
     }
-    writer.emplace(std::move(w).value());
-    tap.emplace(*writer, unixOffset);
-    segment.setCableObserver(0, 0, &*tap);
+    writers.push_back(std::make_unique<PcapWriter>(std::move(w).value()));
+    taps.push_back(std::make_unique<topology::PcapCableTap>(*writers.back(), unixOffset));
+    segment.setCableObserver(ref->slave, ref->port, taps.back().get());
   }
   Link* served = link.get();
 
@@ -79,12 +116,12 @@ int runServe(const ServeOptions& o) {
   topology::NetworkServer server(*served, segment, clock, options);
   SignalFlag stop;
   if (!o.quiet) {
-    fmt::print("ecsim: serving {} slave(s) on {}{}\n", o.slaves, link->describe(),
+    fmt::print("ecsim: serving {} slave(s) on {}{}\n", segment.size(), link->describe(),
                o.pcap.empty() ? "" : fmt::format(", capturing to {}", o.pcap));
     std::fflush(stdout);
   }
   auto status = server.run([&] { return stop.raised(); });
-  if (writer) (void)writer->close();
+  for (auto& w : writers) (void)w->close();
   const auto& c = server.counters();
   const auto& sc = segment.counters();
   fmt::print(
@@ -104,6 +141,8 @@ int runServe(const ServeOptions& o) {
 CommandRunner addServeCommand(CLI::App& app) {
   auto opts = std::make_shared<ServeOptions>();
   auto* cmd = app.add_subcommand("serve", "Answer an EtherCAT master on a network interface");
+  cmd->add_option("topology", opts->topology, "Topology file (default: a line of --slaves)");
+  cmd->add_option("--pcap-link", opts->pcapLinks, "Capture the cable NAME to FILE (NAME=FILE)");
   cmd->add_option("--iface", opts->iface, "Interface to serve (e.g. one end of a veth pair)");
   cmd->add_option("--tap", opts->tap, "Create/open this TAP device and serve on it");
   cmd->add_option("--netns", opts->netns, "Open the interface inside this network namespace");
