@@ -11,5 +11,6 @@ using CommandRunner = std::function<int()>;
 
 CommandRunner addServeCommand(CLI::App& app);
 CommandRunner addDemoCommand(CLI::App& app);
+CommandRunner addNetCommand(CLI::App& app);
 
 }  // namespace ecsim::tools

@@ -10,10 +10,12 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   auto serve = ecsim::tools::addServeCommand(app);
   auto demo = ecsim::tools::addDemoCommand(app);
+  auto net = ecsim::tools::addNetCommand(app);
   CLI11_PARSE(app, argc, argv);
   try {
     if (app.got_subcommand("serve")) return serve();
     if (app.got_subcommand("demo")) return demo();
+    if (app.got_subcommand("net")) return net();
   } catch (const std::exception& e) {
     fmt::print(stderr, "ecsim: {}\n", e.what());
     return 1;

@@ -11,6 +11,7 @@
 #include "link/raw_socket_link.hpp"
 #include "link/signal_flag.hpp"
 #include "link/tap_link.hpp"
+#include "link/veth_setup.hpp"
 #include "slavesim/generic_slave.hpp"
 #include "tools/ecsim/commands.hpp"
 #include "topology/network_builder.hpp"
@@ -24,6 +25,7 @@ struct ServeOptions {
   std::string topology;
   std::vector<std::string> pcapLinks;  // NAME=FILE
   std::string iface;
+  std::string veth;
   std::string tap;
   std::string netns;
   std::string pcap;
@@ -32,10 +34,29 @@ struct ServeOptions {
   bool quiet{false};
 };
 
-int runServe(const ServeOptions& o) {
-  if (o.iface.empty() == o.tap.empty()) {
-    fmt::print(stderr, "ecsim serve: give exactly one of --iface or --tap\n");
+int runServe(ServeOptions o) {
+  if (static_cast<int>(!o.iface.empty()) + static_cast<int>(!o.tap.empty()) +
+          static_cast<int>(!o.veth.empty()) !=
+      1) {
+    fmt::print(stderr, "ecsim serve: give exactly one of --iface, --veth or --tap\n");
     return 2;
+  }
+  // --veth NAME: create the pair for the run (cleaning a stale one) and remove it after.
+  struct VethGuard {
+    std::string name;
+    ~VethGuard() {
+      if (!name.empty()) (void)vethDown(name);
+    }
+  } vethGuard;
+  if (!o.veth.empty()) {
+    auto pair = vethUp(o.veth);
+    if (!pair.ok()) {
+      fmt::print(stderr, "ecsim serve: {}\n", pair.error().message());
+      return 1;
+    }
+    vethGuard.name = o.veth;
+    o.iface = pair->simulatorInterface;
+    fmt::print("ecsim: veth pair ready, point your master at {}\n", pair->masterInterface);
   }
   std::unique_ptr<Link> link;
   if (!o.iface.empty()) {
@@ -144,6 +165,7 @@ CommandRunner addServeCommand(CLI::App& app) {
   cmd->add_option("topology", opts->topology, "Topology file (default: a line of --slaves)");
   cmd->add_option("--pcap-link", opts->pcapLinks, "Capture the cable NAME to FILE (NAME=FILE)");
   cmd->add_option("--iface", opts->iface, "Interface to serve (e.g. one end of a veth pair)");
+  cmd->add_option("--veth", opts->veth, "Create veth pair NAME for this run (master end NAME)");
   cmd->add_option("--tap", opts->tap, "Create/open this TAP device and serve on it");
   cmd->add_option("--netns", opts->netns, "Open the interface inside this network namespace");
   cmd->add_option("--slaves", opts->slaves, "Number of generic slaves in a line")

@@ -1,0 +1,109 @@
+// `ecsim net up/down` and `ecsim serve --veth`: the pair exists while wanted and nothing is
+// left behind, also after the simulator was killed with SIGKILL (the next `up` cleans the
+// stale pair). Everything runs inside a private namespace this test makes.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <thread>
+
+#include "link/netns.hpp"
+#include "support/test_network.hpp"
+
+namespace ecsim::testing {
+namespace {
+
+const std::string kEcsim = std::string(ECSIM_BINARY_DIR) + "/tools/ecsim/ecsim";
+
+#define ECSIM_REQUIRE_NETWORK()                                               \
+  do {                                                                        \
+    if (auto caps = checkNetworkCapabilities(); !caps.ok()) {                 \
+      if (ciMode()) FAIL() << "CI=true and " << caps.error().message();       \
+      GTEST_SKIP() << "needs network privileges: " << caps.error().message(); \
+    }                                                                         \
+  } while (false)
+
+bool linkExists(const VethNamespace& ns, const std::string& ifname) {
+  auto out = ns.run({"ip", "link", "show", ifname});
+  return out.ok() && out->exitCode == 0;
+}
+
+std::string uniqueName() {
+  return "t" + std::to_string(::getpid() % 100000) + "x";
+}
+
+TEST(NetSetup, UpCreatesTheConfiguredPairAndDownRemovesIt) {
+  ECSIM_REQUIRE_NETWORK();
+  auto ns = VethNamespace::create();
+  ASSERT_TRUE(ns.ok()) << ns.error().message();
+  const std::string name = uniqueName();
+  auto up = ns->run({kEcsim, "net", "up", name});
+  ASSERT_TRUE(up.ok());
+  ASSERT_EQ(up->exitCode, 0) << up->output;
+  EXPECT_NE(up->output.find("master interface: " + name), std::string::npos) << up->output;
+  EXPECT_TRUE(linkExists(*ns, name));
+  EXPECT_TRUE(linkExists(*ns, name + "s"));
+  auto v6 = ns->run({"sysctl", "-n", "net.ipv6.conf." + name + ".disable_ipv6"});
+  ASSERT_TRUE(v6.ok());
+  EXPECT_NE(v6->output.find('1'), std::string::npos) << "IPv6 off: " << v6->output;
+  auto state = ns->run({"ip", "-br", "link", "show", name});
+  ASSERT_TRUE(state.ok());
+  EXPECT_NE(state->output.find("UP"), std::string::npos) << state->output;
+  auto down = ns->run({kEcsim, "net", "down", name});
+  ASSERT_TRUE(down.ok());
+  EXPECT_EQ(down->exitCode, 0) << down->output;
+  EXPECT_FALSE(linkExists(*ns, name));
+  EXPECT_FALSE(linkExists(*ns, name + "s"));
+  auto again = ns->run({kEcsim, "net", "down", name});
+  ASSERT_TRUE(again.ok());
+  EXPECT_NE(again->exitCode, 0) << "nothing left to remove is reported";
+}
+
+TEST(NetSetup, SigkilledServeLeavesAPairTheNextUpCleans) {
+  ECSIM_REQUIRE_NETWORK();
+  auto ns = VethNamespace::create();
+  ASSERT_TRUE(ns.ok()) << ns.error().message();
+  const std::string name = uniqueName() + "k";
+  const std::string log = ::testing::TempDir() + "serve_veth_" + name + ".log";
+  auto serve =
+      ns->spawn({kEcsim, "serve", "--veth", name, "--slaves", "2"}, SpawnOptions{log, log});
+  ASSERT_TRUE(serve.ok());
+  for (int i = 0; i < 50 && !linkExists(*ns, name + "s"); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_TRUE(linkExists(*ns, name));
+  ASSERT_TRUE(serve->kill(SIGKILL).ok());
+  ASSERT_TRUE(serve->wait(std::chrono::seconds(5)).ok());
+  EXPECT_TRUE(linkExists(*ns, name)) << "SIGKILL: no chance to clean up";
+  auto up = ns->run({kEcsim, "net", "up", name});
+  ASSERT_TRUE(up.ok());
+  EXPECT_EQ(up->exitCode, 0) << "stale pair cleaned, new one made: " << up->output;
+  auto down = ns->run({kEcsim, "net", "down", name});
+  ASSERT_TRUE(down.ok());
+  EXPECT_EQ(down->exitCode, 0);
+  EXPECT_FALSE(linkExists(*ns, name));
+  EXPECT_FALSE(linkExists(*ns, name + "s"));
+}
+
+TEST(NetSetup, ServeVethRemovesItsPairOnSigint) {
+  ECSIM_REQUIRE_NETWORK();
+  auto ns = VethNamespace::create();
+  ASSERT_TRUE(ns.ok()) << ns.error().message();
+  const std::string name = uniqueName() + "i";
+  const std::string log = ::testing::TempDir() + "serve_veth_" + name + ".log";
+  auto serve = ns->spawn({kEcsim, "serve", "--veth", name}, SpawnOptions{log, log});
+  ASSERT_TRUE(serve.ok());
+  for (int i = 0; i < 50 && !linkExists(*ns, name + "s"); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  ASSERT_TRUE(linkExists(*ns, name));
+  ASSERT_TRUE(serve->kill(SIGINT).ok());
+  auto code = serve->wait(std::chrono::seconds(5));
+  ASSERT_TRUE(code.ok());
+  EXPECT_EQ(*code, 0);
+  EXPECT_FALSE(linkExists(*ns, name));
+}
+
+}  // namespace
+}  // namespace ecsim::testing
