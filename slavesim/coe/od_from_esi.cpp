@@ -1,0 +1,548 @@
+#include "slavesim/coe/od_from_esi.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+#include <optional>
+
+#include "config/sii_builder.hpp"
+#include "slavesim/coe/standard_objects.hpp"
+
+namespace ecsim::slavesim::coe {
+namespace {
+
+std::string upper(std::string_view s) {
+  std::string out(trimEsiText(s));
+  for (auto& c : out) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return out;
+}
+
+std::string hex4(std::uint32_t v) {
+  constexpr char kDigits[] = "0123456789ABCDEF";
+  std::string s = "0x";
+  for (int shift = 12; shift >= 0; shift -= 4) s += kDigits[(v >> shift) & 0xF];
+  return s;
+}
+
+std::uint16_t defaultBits(std::uint16_t code) {
+  namespace dt = data_type;
+  switch (code) {
+    case dt::kBoolean:
+      return 1;
+    case dt::kInteger8:
+    case dt::kUnsigned8:
+    case dt::kByte:
+      return 8;
+    case dt::kInteger16:
+    case dt::kUnsigned16:
+    case dt::kWord:
+      return 16;
+    case dt::kInteger24:
+    case dt::kUnsigned24:
+      return 24;
+    case dt::kInteger32:
+    case dt::kUnsigned32:
+    case dt::kReal32:
+    case dt::kDword:
+      return 32;
+    case dt::kInteger64:
+    case dt::kUnsigned64:
+    case dt::kReal64:
+      return 64;
+    default:
+      break;
+  }
+  if (code >= dt::kBit1 && code <= dt::kBit8)
+    return static_cast<std::uint16_t>(code - dt::kBit1 + 1);
+  return 0;
+}
+
+bool isIntegerCode(std::uint16_t code) {
+  return defaultBits(code) > 0 && !isRealType(code);
+}
+
+std::uint16_t typeForBits(std::uint32_t bits) {
+  if (bits == 1) return data_type::kBoolean;
+  if (bits > 1 && bits < 8) return data_type::bitType(bits);
+  switch (bits) {
+    case 8:
+      return data_type::kUnsigned8;
+    case 16:
+      return data_type::kUnsigned16;
+    case 24:
+      return data_type::kUnsigned24;
+    case 32:
+      return data_type::kUnsigned32;
+    case 64:
+      return data_type::kUnsigned64;
+    default:
+      return data_type::kOctetString;
+  }
+}
+
+std::uint16_t clampBits(std::uint32_t bits) {
+  return static_cast<std::uint16_t>(std::min<std::uint32_t>(bits, 0xFFFF));
+}
+
+ResolvedType resolve(const EsiDictionary& dict, std::string_view typeName, std::uint32_t hint,
+                     int depth) {
+  const std::string name = upper(typeName);
+  if (name.rfind("STRING", 0) == 0) {
+    return {data_type::kVisibleString, clampBits(hint)};
+  }
+  if (std::uint16_t code = coeDataTypeCode(name); code != 0) {
+    const std::uint16_t bits = hint != 0 ? clampBits(hint) : defaultBits(code);
+    if (code == data_type::kBoolean && bits > 1) return {typeForBits(bits), bits};
+    return {code, bits};
+  }
+  const EsiDataType* dt = depth < 8 ? dict.findDataType(trimEsiText(typeName)) : nullptr;
+  if (dt != nullptr && !dt->isRecord()) {
+    const std::uint32_t bits = dt->bitSize != 0 ? dt->bitSize : hint;
+    if (dt->isArray()) return {data_type::kOctetString, clampBits(bits)};
+    ResolvedType base = resolve(dict, dt->baseType, bits, depth + 1);
+    if (bits > 0 && bits < 8 && isIntegerCode(base.dataType)) {
+      return {typeForBits(bits), clampBits(bits)};
+    }
+    return {base.dataType, clampBits(bits != 0 ? bits : base.bitLength)};
+  }
+  // Vendor decorations such as "UINT_hex", "UDINT_hex".
+  if (auto cut = name.find('_'); cut != std::string::npos && cut > 0) {
+    if (std::uint16_t code = coeDataTypeCode(name.substr(0, cut)); code != 0) {
+      return {code, hint != 0 ? clampBits(hint) : defaultBits(code)};
+    }
+  }
+  return {typeForBits(hint), clampBits(hint)};
+}
+
+std::uint16_t stateBits(std::string_view restrictions, bool write) {
+  const std::uint16_t pre = write ? kAccessWritePreOp : kAccessReadPreOp;
+  const std::uint16_t safe = write ? kAccessWriteSafeOp : kAccessReadSafeOp;
+  const std::uint16_t op = write ? kAccessWriteOp : kAccessReadOp;
+  if (trimEsiText(restrictions).empty()) return static_cast<std::uint16_t>(pre | safe | op);
+  std::uint16_t bits = 0;
+  std::string token;
+  const std::string text = upper(restrictions) + "_";
+  for (char c : text) {
+    if (c == '_' || c == ',' || c == ' ') {
+      if (token == "PREOP") bits |= pre;
+      if (token == "SAFEOP") bits |= safe;
+      if (token == "OP") bits |= op;
+      token.clear();
+    } else {
+      token += c;
+    }
+  }
+  return bits;
+}
+
+std::uint16_t pdoBits(const EsiFlags& flags) {
+  std::uint16_t bits = 0;
+  if (flags.rxMappable()) bits |= access::kRxMappable;
+  if (flags.txMappable()) bits |= access::kTxMappable;
+  return bits;
+}
+
+// A number (or text for strings) in the entry's wire format.
+std::optional<std::vector<std::uint8_t>> numberBytes(std::string_view text, std::uint16_t type,
+                                                     std::size_t size) {
+  std::vector<std::uint8_t> out(size, 0);
+  if (isStringType(type)) {
+    std::copy_n(text.begin(), std::min(text.size(), size), out.begin());
+    return out;
+  }
+  if (isRealType(type)) {
+    const std::string s(trimEsiText(text));
+    char* end = nullptr;
+    const double v = std::strtod(s.c_str(), &end);
+    if (s.empty() || end == s.c_str()) return std::nullopt;
+    if (size == 4) writeLe32(out, 0, std::bit_cast<std::uint32_t>(static_cast<float>(v)));
+    if (size == 8) writeLe64(out, 0, std::bit_cast<std::uint64_t>(v));
+    return out;
+  }
+  auto v = parseEsiInteger(text);
+  if (!v.ok()) return std::nullopt;
+  writeRawValue(out, static_cast<std::uint64_t>(*v), 0);
+  return out;
+}
+
+bool applyValueInfo(Entry& e, const EsiValueInfo& info) {
+  const std::size_t size = e.byteSize();
+  std::optional<std::vector<std::uint8_t>> value;
+  if (!info.defaultData.empty()) {
+    value = info.defaultData;
+    value->resize(size, 0);
+  } else if (info.defaultValue) {
+    value = numberBytes(*info.defaultValue, e.dataType, size);
+  } else if (info.defaultString) {
+    value = numberBytes(*info.defaultString, data_type::kVisibleString, size);
+  }
+  if (value) {
+    e.value = *value;
+    e.defaultValue = *value;
+  }
+  if (!isStringType(e.dataType)) {
+    if (info.minValue) {
+      if (auto m = numberBytes(*info.minValue, e.dataType, size)) e.minimum = *m;
+    }
+    if (info.maxValue) {
+      if (auto m = numberBytes(*info.maxValue, e.dataType, size)) e.maximum = *m;
+    }
+  }
+  return value.has_value();
+}
+
+struct Slot {
+  Entry entry;
+  const EsiFlags* typeFlags{nullptr};
+  bool fromArray{false};
+};
+
+Slot makeSlot(std::uint8_t sub, const ResolvedType& t, std::uint32_t bits, std::string name,
+              const EsiFlags* flags, bool fromArray) {
+  Slot s;
+  s.entry.subindex = sub;
+  s.entry.dataType = t.dataType;
+  s.entry.bitLength = bits != 0 ? clampBits(bits) : t.bitLength;
+  s.entry.name = std::move(name);
+  s.typeFlags = flags;
+  s.fromArray = fromArray;
+  return s;
+}
+
+std::uint16_t recordTypeFor(std::uint16_t index) {
+  if (index == kIdentityIndex) return data_type::kIdentity;
+  if (isPdoMappingIndex(index)) return data_type::kPdoMapping;
+  if (index == kSmOutputParameterIndex || index == kSmInputParameterIndex) {
+    return data_type::kSyncManagerParameter;
+  }
+  return data_type::kRecord;
+}
+
+std::string paddedSubName(unsigned sub) {
+  std::string digits = std::to_string(sub);
+  return "SubIndex " + std::string(3 - std::min<std::size_t>(3, digits.size()), '0') + digits;
+}
+
+Object buildObject(const EsiObject& o, const EsiDictionary& dict) {
+  Object object;
+  object.index = static_cast<std::uint16_t>(o.index);
+  object.name = o.name();
+  std::vector<Slot> slots;
+  const EsiDataType* dt = dict.findDataType(trimEsiText(o.type));
+  bool expanded = false;
+  std::uint16_t elementType = 0;
+  auto expandArray = [&](const EsiDataType& array, std::uint32_t totalBits, std::uint32_t firstSub,
+                         const std::string& name, const EsiFlags* flags) {
+    const std::uint32_t n = array.arrays.front().elements;
+    ResolvedType t = resolve(dict, array.baseType, 0, 0);
+    if (t.bitLength == 0 && n != 0) t.bitLength = clampBits(totalBits / n);
+    for (std::uint32_t i = 0; i < n && firstSub + i <= 255; ++i) {
+      slots.push_back(
+          makeSlot(static_cast<std::uint8_t>(firstSub + i), t, t.bitLength, name, flags, true));
+    }
+    expanded = true;
+    elementType = t.dataType;
+  };
+  if (dt != nullptr && dt->isRecord()) {
+    for (std::size_t p = 0; p < dt->subItems.size(); ++p) {
+      const EsiSubItemType& sit = dt->subItems[p];
+      const EsiDataType* sdt = dict.findDataType(trimEsiText(sit.type));
+      if (sdt != nullptr && sdt->isArray() && !sdt->isRecord() && p > 0 && sit.subIndex == 0) {
+        // "Elements" without SubIdx: one subindex per element.
+        const std::int64_t lbound = sdt->arrays.front().lowerBound;
+        expandArray(*sdt, sit.bitSize, lbound >= 1 ? static_cast<std::uint32_t>(lbound) : 1,
+                    sit.name, &sit.flags);
+      } else {
+        slots.push_back(makeSlot(sit.subIndex, resolve(dict, sit.type, sit.bitSize, 0), sit.bitSize,
+                                 sit.name, &sit.flags, false));
+      }
+    }
+    object.code =
+        expanded && !isPdoMappingIndex(object.index) ? ObjectCode::kArray : ObjectCode::kRecord;
+    object.dataType = object.code == ObjectCode::kArray ? elementType : recordTypeFor(object.index);
+  } else if (dt != nullptr && dt->isArray() && upper(dt->baseType) != "BYTE" &&
+             upper(dt->baseType) != "USINT") {
+    slots.push_back(
+        makeSlot(0, {data_type::kUnsigned8, 8}, 8, "Number of entries", nullptr, false));
+    expandArray(*dt, dt->bitSize, 1, object.name, nullptr);
+    object.code = ObjectCode::kArray;
+    object.dataType = elementType;
+  } else {
+    ResolvedType t = resolve(dict, o.type, o.bitSize, 0);
+    slots.push_back(makeSlot(0, t, o.bitSize, object.name, nullptr, false));
+    object.code = ObjectCode::kVar;
+    object.dataType = t.dataType;
+  }
+  // Info/SubItem: by name, else by position.
+  std::vector<bool> used(slots.size(), false);
+  std::vector<const EsiSubItemInfo*> info(slots.size(), nullptr);
+  for (std::size_t k = 0; k < o.subItems.size(); ++k) {
+    const EsiSubItemInfo& si = o.subItems[k];
+    std::size_t pick = slots.size();
+    for (std::size_t j = 0; j < slots.size(); ++j) {
+      if (!used[j] && !slots[j].fromArray && slots[j].entry.name == si.name) {
+        pick = j;
+        break;
+      }
+    }
+    if (pick == slots.size() && k < slots.size() && !used[k]) pick = k;
+    if (pick == slots.size()) continue;
+    used[pick] = true;
+    info[pick] = &si;
+  }
+  for (std::size_t j = 0; j < slots.size(); ++j) {
+    Slot& s = slots[j];
+    Entry& e = s.entry;
+    const EsiSubItemInfo* si = info[j];
+    if (s.fromArray)
+      e.name = si != nullptr && !si->name.empty() ? si->name : paddedSubName(e.subindex);
+    // Flags: Info/SubItem overrides the DataType's SubItem, which overrides the object's.
+    const EsiFlags* chosen = nullptr;
+    for (const EsiFlags* f :
+         {si != nullptr && si->flags ? &*si->flags : nullptr, s.typeFlags, &o.flags}) {
+      if (f != nullptr && f->access != EsiAccess::kUnspecified) {
+        chosen = f;
+        break;
+      }
+    }
+    e.access = chosen != nullptr ? accessFromEsiFlags(*chosen) : access::kReadOnly;
+    for (const EsiFlags* f :
+         {si != nullptr && si->flags ? &*si->flags : nullptr, s.typeFlags, &o.flags}) {
+      if (f != nullptr && !f->pdoMapping.empty()) {
+        e.access = static_cast<std::uint16_t>(
+            (e.access & ~(access::kRxMappable | access::kTxMappable)) | pdoBits(*f));
+        break;
+      }
+    }
+    e.value.assign(e.byteSize(), 0);
+    e.defaultValue = e.value;
+    const bool given = applyValueInfo(
+        e, object.code == ObjectCode::kVar ? o.info : (si != nullptr ? si->info : EsiValueInfo{}));
+    if (!given && object.code != ObjectCode::kVar && e.subindex == 0 && e.value.size() == 1) {
+      std::uint8_t highest = 0;
+      for (const Slot& other : slots) highest = std::max(highest, other.entry.subindex);
+      e.value[0] = highest;  // no default given: sub 0 tells the highest subindex
+      e.defaultValue = e.value;
+    }
+    object.entries.push_back(std::move(e));
+  }
+  return object;
+}
+
+std::uint8_t smTypeOf(const EsiSyncManager& sm) {
+  const std::string text = upper(sm.text);
+  if (text == "MBOXOUT") return kSmTypeMailboxOut;
+  if (text == "MBOXIN") return kSmTypeMailboxIn;
+  if (text == "OUTPUTS") return kSmTypeOutputs;
+  if (text == "INPUTS") return kSmTypeInputs;
+  if (sm.controlByte == 0) return kSmTypeUnused;
+  const bool mailbox = (sm.controlByte & 0x03) == 0x02;
+  const bool masterWrites = (sm.controlByte & 0x0C) == 0x04;
+  if (mailbox) return masterWrites ? kSmTypeMailboxOut : kSmTypeMailboxIn;
+  return masterWrites ? kSmTypeOutputs : kSmTypeInputs;
+}
+
+void limitWritesToPreOp(Object& o, bool readOnly) {
+  for (auto& e : o.entries) {
+    const auto keep = static_cast<std::uint16_t>(readOnly ? ~access::kWriteAll
+                                                          : ~(kAccessWriteSafeOp | kAccessWriteOp));
+    e.access = static_cast<std::uint16_t>(e.access & keep);
+  }
+}
+
+// Entries of an ESI PDO as mapping values.
+std::vector<MappedObject> mappingOf(const EsiPdo& pdo) {
+  std::vector<MappedObject> out;
+  for (const auto& e : pdo.entries) {
+    out.push_back({e.index, e.subIndex,
+                   static_cast<std::uint8_t>(std::min<std::uint16_t>(e.bitLength, 255))});
+  }
+  return out;
+}
+
+void addMappedObjects(ObjectDictionary& od, const EsiPdo& pdo, bool rx) {
+  const std::uint16_t mappable = rx ? access::kRxMappable : access::kTxMappable;
+  for (const auto& pe : pdo.entries) {
+    if (pe.index == 0) continue;
+    if (Entry* e = od.findEntry(pe.index, pe.subIndex); e != nullptr) {
+      e->access |= mappable;
+      continue;
+    }
+    std::uint16_t type = coeDataTypeCode(pe.dataType);
+    if (type == 0 || (type == data_type::kBoolean && pe.bitLength > 1))
+      type = typeForBits(pe.bitLength);
+    const std::uint16_t rights =
+        static_cast<std::uint16_t>((rx ? access::kReadWrite : access::kReadOnly) | mappable);
+    if (pe.subIndex == 0 && od.find(pe.index) == nullptr) {
+      od.addVar(pe.index, pe.name.empty() ? pdo.name() : pe.name, type, pe.bitLength, rights);
+      continue;
+    }
+    if (od.find(pe.index) == nullptr) {
+      od.addRecord(pe.index, pdo.name().empty() ? pe.name : pdo.name(), data_type::kRecord);
+    }
+    Entry e;
+    e.subindex = pe.subIndex;
+    e.dataType = type;
+    e.bitLength = pe.bitLength;
+    e.name = pe.name;
+    e.access = rights;
+    od.addEntry(pe.index, std::move(e));
+  }
+}
+
+}  // namespace
+
+ResolvedType resolveEsiType(const EsiDictionary& dictionary, std::string_view typeName,
+                            std::uint32_t bitSizeHint) {
+  return resolve(dictionary, typeName, bitSizeHint, 0);
+}
+
+std::uint16_t accessFromEsiFlags(const EsiFlags& flags) {
+  std::uint16_t bits = 0;
+  switch (flags.access) {
+    case EsiAccess::kUnspecified:
+    case EsiAccess::kReadOnly:
+      bits = stateBits(flags.readRestrictions, false);
+      break;
+    case EsiAccess::kReadWrite:
+      bits = static_cast<std::uint16_t>(stateBits(flags.readRestrictions, false) |
+                                        stateBits(flags.writeRestrictions, true));
+      break;
+    case EsiAccess::kWriteOnly:
+      bits = stateBits(flags.writeRestrictions, true);
+      break;
+  }
+  return static_cast<std::uint16_t>(bits | pdoBits(flags));
+}
+
+ObjectDictionary buildObjectDictionary(const EsiDevice& device, const OdBuildOptions& options,
+                                       OdBuildReport* report) {
+  auto note = [&](std::string text) {
+    if (report != nullptr) report->notes.push_back(std::move(text));
+  };
+  ObjectDictionary od;
+  for (const EsiObject& o : device.dictionary.objects) {
+    if (o.index > 0xFFFF) {
+      note("object index " + std::to_string(o.index) + " is not a CoE index: skipped");
+      continue;
+    }
+    od.insert(buildObject(o, device.dictionary));
+  }
+
+  // Communication area.
+  if (!od.contains(kDeviceTypeIndex)) {
+    od.addVar(kDeviceTypeIndex, "Device type", data_type::kUnsigned32, 32, access::kReadOnly);
+    (void)od.set<std::uint32_t>(kDeviceTypeIndex, 0, device.profileNo.value_or(0));
+    od.findEntry(kDeviceTypeIndex, 0)->defaultValue = od.findEntry(kDeviceTypeIndex, 0)->value;
+  }
+  if (!od.contains(kDeviceNameIndex)) od.addString(kDeviceNameIndex, "Device name", device.name());
+  if (!od.contains(kHardwareVersionIndex)) {
+    od.addString(kHardwareVersionIndex, "Hardware version", std::to_string(device.revision >> 16));
+  }
+  if (!od.contains(kSoftwareVersionIndex)) {
+    od.addString(kSoftwareVersionIndex, "Software version",
+                 std::to_string(device.revision & 0xFFFF));
+  }
+  addIdentityObject(od, {options.vendorId, device.productCode, device.revision, options.serial});
+
+  if (!od.contains(kSmTypesIndex)) {
+    std::vector<std::uint8_t> types;
+    for (const auto& sm : device.syncManagers) types.push_back(smTypeOf(sm));
+    addSyncManagerTypes(od, types);
+  }
+
+  // PDO mapping objects and their rules.
+  const bool pdoConfig = device.mailbox.coeDetails.pdoConfig;
+  for (int dir = 0; dir < 2; ++dir) {
+    const bool rx = dir == 0;
+    for (const EsiPdo& pdo : rx ? device.rxPdos : device.txPdos) {
+      PdoRules& rules = od.pdoRules(pdo.index);
+      rules.fixed = pdo.fixed;
+      rules.mandatory = pdo.mandatory;
+      rules.defaultSm = pdo.sm;
+      rules.excludes = pdo.excludes;
+      addMappedObjects(od, pdo, rx);
+      std::vector<MappedObject> entries = mappingOf(pdo);
+      if (Object* existing = od.find(pdo.index); existing != nullptr) {
+        limitWritesToPreOp(*existing, pdo.fixed);
+        if (!entries.empty() && mappedObjects(od, pdo.index).empty()) {
+          Entry* sub0 = existing->entry(0);
+          std::size_t n = 0;
+          for (; n < entries.size(); ++n) {
+            Entry* e = existing->entry(static_cast<std::uint8_t>(n + 1));
+            if (e == nullptr || e->value.size() < 4) break;
+            writeLe32(e->value, 0, entries[n].raw());
+            e->defaultValue = e->value;
+          }
+          if (sub0 != nullptr && !sub0->value.empty()) {
+            sub0->value[0] = static_cast<std::uint8_t>(n);
+            sub0->defaultValue = sub0->value;
+          }
+        }
+        continue;
+      }
+      PdoMappingSpec spec;
+      spec.index = pdo.index;
+      spec.name = pdo.name();
+      spec.entries = std::move(entries);
+      for (const auto& e : pdo.entries) spec.entryNames.push_back(e.name);
+      spec.fixed = pdo.fixed;
+      spec.capacity = pdoConfig && !pdo.fixed ? options.configurableMappingCapacity : 0;
+      addPdoMapping(od, spec);
+    }
+  }
+
+  // PDO assignment per process-data SM.
+  const Object* types = od.find(kSmTypesIndex);
+  for (const Entry& t : types->entries) {
+    if (t.subindex == 0 || t.value.empty()) continue;
+    const unsigned sm = t.subindex - 1u;
+    const bool outputs = t.value[0] == kSmTypeOutputs;
+    if (!outputs && t.value[0] != kSmTypeInputs) continue;
+    std::vector<std::uint16_t> assigned;
+    std::size_t candidates = 0;
+    for (const EsiPdo& pdo : outputs ? device.rxPdos : device.txPdos) {
+      if (pdo.sm && *pdo.sm == sm) assigned.push_back(pdo.index);
+      if (!pdo.sm || *pdo.sm == sm) ++candidates;
+    }
+    const auto index = static_cast<std::uint16_t>(kPdoAssignBase + sm);
+    if (Object* existing = od.find(index); existing != nullptr) {
+      limitWritesToPreOp(*existing, false);
+      std::vector<std::uint16_t> esiValues = assignedPdos(od, sm);
+      if (esiValues.empty() && !assigned.empty()) {
+        std::size_t n = 0;
+        for (; n < assigned.size(); ++n) {
+          Entry* e = existing->entry(static_cast<std::uint8_t>(n + 1));
+          if (e == nullptr || e->value.size() < 2) break;
+          writeLe16(e->value, 0, assigned[n]);
+          e->defaultValue = e->value;
+        }
+        if (Entry* sub0 = existing->entry(0); sub0 != nullptr && !sub0->value.empty()) {
+          sub0->value[0] = static_cast<std::uint8_t>(n);
+          sub0->defaultValue = sub0->value;
+        }
+      } else if (esiValues != assigned) {
+        note(hex4(index) + ": ESI default assignment differs from the PDOs with Sm=" +
+             std::to_string(sm) + "; the dictionary's default is used");
+      }
+      continue;
+    }
+    const bool writable = device.mailbox.coeDetails.pdoAssign || candidates > assigned.size();
+    addPdoAssignment(
+        od, sm, assigned,
+        static_cast<std::uint8_t>(std::min<std::size_t>(std::max<std::size_t>(candidates, 1), 254)),
+        writable);
+  }
+
+  bool dc = false;
+  for (const auto& mode : device.dcOpModes) dc = dc || (mode.assignActivate & 0x0300) != 0;
+  SyncParameters sync;
+  if (dc) sync.supported |= kSupportsDcSync0;
+  if (!od.contains(kSmOutputParameterIndex))
+    addSyncManagerParameters(od, kSmOutputParameterIndex, sync);
+  if (!od.contains(kSmInputParameterIndex))
+    addSyncManagerParameters(od, kSmInputParameterIndex, sync);
+  return od;
+}
+
+}  // namespace ecsim::slavesim::coe

@@ -1,0 +1,100 @@
+#include "slavesim/esi_slave.hpp"
+
+#include <algorithm>
+
+#include "config/sii_builder.hpp"
+#include "slavesim/coe/od_from_esi.hpp"
+#include "slavesim/coe/standard_objects.hpp"
+
+namespace ecsim::slavesim {
+namespace {
+
+constexpr std::uint32_t kRamStart = reg::kRegisterSpaceEnd;
+
+std::size_t portCount(const EsiDevice& device) {
+  std::size_t n = 0;
+  for (char c : device.physics) n += c == ' ' ? 0 : 1;
+  return n == 0 ? 2 : n;
+}
+
+}  // namespace
+
+EscType chooseEscType(const EsiDevice& device) {
+  const EscType& small = kLan9252;
+  if (device.syncManagers.size() > small.syncManagers || device.fmmus.size() > small.fmmus ||
+      portCount(device) > small.maxPorts) {
+    return kEt1100;
+  }
+  const std::uint32_t ramEnd = kRamStart + static_cast<std::uint32_t>(small.ramKb) * 1024;
+  for (const auto& sm : device.syncManagers) {
+    const std::uint32_t size = std::max<std::uint32_t>(sm.defaultSize, sm.maxSize.value_or(0));
+    if (sm.startAddress < kRamStart || sm.startAddress + size > ramEnd) return kEt1100;
+  }
+  return small;
+}
+
+Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiDevice& device, std::string name,
+                                                const EsiSlaveOptions& options) {
+  SiiBuildOptions siiOptions;
+  siiOptions.serial = options.serial;
+  siiOptions.deviceNameFirst = options.deviceNameFirst;
+  ECSIM_ASSIGN_OR_RETURN(SiiContents sii, makeSiiContents(device, options.vendorId, siiOptions));
+  std::vector<std::uint8_t> image;
+  if (device.eeprom && device.eeprom->data.size() >= sii::kHeaderBytes) {
+    image = device.eeprom->data;  // the vendor's own image, as the device carries it
+  } else {
+    ECSIM_ASSIGN_OR_RETURN(image, encodeSii(sii));
+  }
+
+  SlaveProfile profile;
+  const SiiMailbox& mbx = sii.standardMailbox;
+  if (mbx.receiveSize > 0) {
+    profile.mailbox = SlaveProfile::Mailbox{mbx.receiveOffset, mbx.receiveSize, mbx.sendOffset,
+                                            mbx.sendSize != 0 ? mbx.sendSize : mbx.receiveSize};
+  }
+
+  coe::OdBuildOptions odOptions;
+  odOptions.vendorId = options.vendorId;
+  odOptions.serial = options.serial;
+  auto od = std::make_shared<coe::ObjectDictionary>(coe::buildObjectDictionary(device, odOptions));
+  // 0x1018 says what the SII says (they differ when a vendor image carries another identity).
+  coe::addIdentityObject(*od, {sii.identity.vendorId, sii.identity.productCode,
+                               sii.identity.revision, sii.identity.serial});
+
+  auto pd = std::make_unique<ProcessDataDevice>(od);
+  pd->updateProfile(profile);
+
+  auto slave =
+      std::make_unique<Slave>(std::move(name), options.escType.value_or(chooseEscType(device)),
+                              std::move(image), std::move(profile));
+  if (slave->profile().mailbox) {
+    coe::CoeServerOptions coeOptions;
+    coeOptions.coe = device.mailbox.coe;
+    coeOptions.sdoInfo = device.mailbox.coeDetails.sdoInfo;
+    coeOptions.completeAccess = device.mailbox.coeDetails.completeAccess;
+    slave->setMailboxServer(std::make_unique<coe::CoeServer>(od, coeOptions));
+  }
+  slave->setDevice(std::move(pd));
+  return slave;
+}
+
+Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiFile& file, const EsiDevice& device,
+                                                std::string name, EsiSlaveOptions options) {
+  options.vendorId = file.vendor.id;
+  return makeSlaveFromEsi(device, std::move(name), options);
+}
+
+ProcessDataDevice* processDataDeviceOf(Slave& slave) {
+  return dynamic_cast<ProcessDataDevice*>(slave.device());
+}
+
+coe::ObjectDictionary* objectDictionaryOf(Slave& slave) {
+  ProcessDataDevice* pd = processDataDeviceOf(slave);
+  return pd == nullptr ? nullptr : &pd->dictionary();
+}
+
+coe::CoeServer* coeServerOf(Slave& slave) {
+  return dynamic_cast<coe::CoeServer*>(slave.mailboxServer());
+}
+
+}  // namespace ecsim::slavesim

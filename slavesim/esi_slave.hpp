@@ -1,0 +1,55 @@
+// A simulated slave built from an ESI device description:
+//   SII image  config/sii_builder.hpp (or the vendor's <Eeprom><Data> image as it is);
+//   ESC type   chooseEscType() below, unless the options name one;
+//   profile    standard mailbox from the SII (which the builder takes from the ESI MBoxOut /
+//              MBoxIn SMs), process-data SM lengths from the PDO configuration;
+//   dictionary coe/od_from_esi.hpp, identity taken from the SII so SII and 0x1018 agree;
+//   mailbox    a CoeServer for any device with a standard mailbox (SdoInfo / CompleteAccess
+//              from the ESI <CoE> element); other protocols (and CoE, when the ESI mailbox
+//              has none) get "unsupported protocol" mailbox error replies;
+//   device     ProcessDataDevice over the same dictionary (also for SII-only slaves, whose
+//              dictionary no mailbox reaches).
+// Bootstrap (BOOT state) and modules/slots are not modelled.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "config/esi.hpp"
+#include "protocol/result.hpp"
+#include "protocol/sii.hpp"
+#include "slavesim/coe/coe_server.hpp"
+#include "slavesim/coe/object_dictionary.hpp"
+#include "slavesim/esc_type.hpp"
+#include "slavesim/process_data.hpp"
+#include "slavesim/slave.hpp"
+
+namespace ecsim::slavesim {
+
+struct EsiSlaveOptions {
+  std::uint32_t vendorId{0};  // <Vendor><Id>; the EsiFile overload fills it in
+  std::uint32_t serial{0};
+  std::optional<EscType> escType;
+  // SII string 1 (SOEM's slave name): the ESI <Name> when true, the <Type> text otherwise.
+  bool deviceNameFirst{true};
+};
+
+// ET1100 by default. A LAN9252-class ESC (4 SMs, 3 FMMUs, 2 ports, 4 KB process RAM) when
+// the device fits it: at most 4 SMs and 3 FMMUs in the ESI, at most 2 ports in its Physics,
+// and every SM inside 0x1000-0x1FFF.
+EscType chooseEscType(const EsiDevice& device);
+
+Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiDevice& device, std::string name,
+                                                const EsiSlaveOptions& options = {});
+// Same, with the vendor id from the file.
+Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiFile& file, const EsiDevice& device,
+                                                std::string name, EsiSlaveOptions options = {});
+
+// The parts of a slave made by makeSlaveFromEsi (nullptr for other slaves).
+ProcessDataDevice* processDataDeviceOf(Slave& slave);
+coe::ObjectDictionary* objectDictionaryOf(Slave& slave);
+coe::CoeServer* coeServerOf(Slave& slave);
+
+}  // namespace ecsim::slavesim

@@ -1,0 +1,156 @@
+#include "slavesim/process_data.hpp"
+
+#include <algorithm>
+#include <string>
+
+#include "slavesim/coe/sdo_access.hpp"
+
+namespace ecsim::slavesim {
+namespace {
+
+std::string hex4(std::uint32_t v) {
+  constexpr char kDigits[] = "0123456789ABCDEF";
+  std::string s = "0x";
+  for (int shift = 12; shift >= 0; shift -= 4) s += kDigits[(v >> shift) & 0xF];
+  return s;
+}
+
+constexpr std::uint16_t kUnusableLength = 0xFFFF;  // no master configuration matches it
+
+// The ESC's 3-buffer model covers SMs in process RAM only (an SM over registers, such as the
+// 2006-era EL2004's SM0 at 0x0F00, holds no buffer): copy only through SMs that lie there.
+bool inProcessRam(const Esc& esc, unsigned sm) {
+  const Esc::SmConfig c = esc.smConfig(sm);
+  return c.start >= reg::kRegisterSpaceEnd &&
+         static_cast<std::size_t>(c.start) + c.length <= esc.memorySize();
+}
+
+}  // namespace
+
+Result<std::vector<ProcessDataSmLayout>> computeProcessDataLayout(const coe::ObjectDictionary& od) {
+  std::vector<ProcessDataSmLayout> out;
+  const coe::Object* types = od.find(coe::kSmTypesIndex);
+  if (types == nullptr) return out;
+  for (const coe::Entry& t : types->entries) {
+    if (t.subindex == 0 || t.value.empty()) continue;
+    const bool outputs = t.value[0] == coe::kSmTypeOutputs;
+    if (!outputs && t.value[0] != coe::kSmTypeInputs) continue;
+    ProcessDataSmLayout sm;
+    sm.sm = t.subindex - 1u;
+    sm.outputs = outputs;
+    const auto assignIndex = static_cast<std::uint16_t>(coe::kPdoAssignBase + sm.sm);
+    if (!od.contains(assignIndex)) continue;
+    for (std::uint16_t pdo : coe::assignedPdos(od, sm.sm)) {
+      if (!od.contains(pdo)) {
+        return makeError(ErrorCode::kNotFound, hex4(assignIndex) + " assigns PDO " + hex4(pdo) +
+                                                   ", which does not exist");
+      }
+      for (const coe::MappedObject& m : coe::mappedObjects(od, pdo)) {
+        if (m.index != 0) {
+          const coe::Entry* e = od.findEntry(m.index, m.subindex);
+          if (e == nullptr) {
+            return makeError(ErrorCode::kNotFound, "PDO " + hex4(pdo) + " maps " + hex4(m.index) +
+                                                       ":" + std::to_string(m.subindex) +
+                                                       ", which does not exist");
+          }
+          if (m.bitLength > 8 * e->byteSize()) {
+            return makeError(ErrorCode::kInvalidArgument,
+                             "PDO " + hex4(pdo) + " maps " + std::to_string(m.bitLength) +
+                                 " bits of " + hex4(m.index) + ":" + std::to_string(m.subindex) +
+                                 ", which has " + std::to_string(e->bitLength));
+          }
+        }
+        sm.entries.push_back(m);
+        sm.bitLength += m.bitLength;
+      }
+    }
+    out.push_back(std::move(sm));
+  }
+  return out;
+}
+
+Status ProcessDataBinding::bind(coe::ObjectDictionary& od) {
+  layout_.clear();
+  buffers_.clear();
+  copies_.clear();
+  auto layout = computeProcessDataLayout(od);
+  if (!layout.ok()) return layout.takeError();
+  layout_ = std::move(layout).value();
+  for (const ProcessDataSmLayout& sm : layout_) {
+    const std::size_t buffer = buffers_.size();
+    buffers_.push_back({sm.sm, sm.outputs, std::vector<std::uint8_t>(sm.byteLength(), 0)});
+    std::uint32_t offset = 0;
+    for (const coe::MappedObject& m : sm.entries) {
+      if (m.index != 0 && m.bitLength > 0) {
+        coe::Entry* e = od.findEntry(m.index, m.subindex);
+        copies_.push_back({buffer, offset, m.bitLength, e->value.data(), e->value.size()});
+      }
+      offset += m.bitLength;
+    }
+  }
+  return okStatus();
+}
+
+void ProcessDataBinding::fillProfile(SlaveProfile& profile) const {
+  profile.processData.clear();
+  for (const ProcessDataSmLayout& sm : layout_) {
+    profile.processData.push_back({sm.sm, sm.outputs, sm.byteLength()});
+  }
+}
+
+void ProcessDataBinding::readOutputs(const Esc& esc) {
+  for (const Copy& c : copies_) {
+    const Buffer& b = buffers_[c.buffer];
+    if (!b.outputs || !esc.pdiOutputsReceived(b.sm) || !inProcessRam(esc, b.sm)) continue;
+    const ConstBytes src = esc.pdiOutputs(b.sm);
+    if (static_cast<std::size_t>(c.bitOffset) + c.bits > 8 * src.size()) continue;
+    coe::copyBits(Bytes(c.value, c.valueSize), 0, src, c.bitOffset, c.bits);
+  }
+}
+
+void ProcessDataBinding::writeInputs(Esc& esc) {
+  for (const Copy& c : copies_) {
+    Buffer& b = buffers_[c.buffer];
+    if (b.outputs) continue;
+    coe::copyBits(b.bytes, c.bitOffset, ConstBytes(c.value, c.valueSize), 0, c.bits);
+  }
+  for (Buffer& b : buffers_) {
+    if (!b.outputs && !b.bytes.empty() && inProcessRam(esc, b.sm)) {
+      esc.pdiWriteInputs(b.sm, b.bytes);
+    }
+  }
+}
+
+ProcessDataDevice::ProcessDataDevice(std::shared_ptr<coe::ObjectDictionary> od)
+    : od_(std::move(od)) {
+  bindStatus_ = binding_.bind(*od_);
+}
+
+void ProcessDataDevice::updateProfile(SlaveProfile& profile) {
+  bindStatus_ = binding_.bind(*od_);
+  if (bindStatus_.ok()) {
+    binding_.fillProfile(profile);
+    return;
+  }
+  // An unusable PDO configuration: no SM configuration can satisfy the ESM, so
+  // PREOP->SAFEOP is refused with "invalid output/input configuration".
+  profile.processData.clear();
+  if (const coe::Object* types = od_->find(coe::kSmTypesIndex); types != nullptr) {
+    for (const coe::Entry& t : types->entries) {
+      if (t.subindex == 0 || t.value.empty()) continue;
+      if (t.value[0] == coe::kSmTypeOutputs || t.value[0] == coe::kSmTypeInputs) {
+        profile.processData.push_back(
+            {t.subindex - 1u, t.value[0] == coe::kSmTypeOutputs, kUnusableLength});
+      }
+    }
+  }
+}
+
+void ProcessDataDevice::step(Esc& esc, AlState state, SimTime now) {
+  const bool exchanging = state == AlState::kSafeOp || state == AlState::kOp;
+  if (exchanging) binding_.readOutputs(esc);
+  if (application_) application_->step(*od_, state, now);
+  if (exchanging) binding_.writeInputs(esc);
+}
+
+}  // namespace ecsim::slavesim

@@ -1,0 +1,113 @@
+// Process data of a dictionary-based slave: from the PDO assignment (0x1C10+n) and mapping
+// objects (0x16xx/0x1Axx) currently in the object dictionary, the layout of every process-data
+// SyncManager (what SM2/SM3 lengths the slave expects, fed to the ESM before PREOP->SAFEOP so
+// a wrong length gives AL status 0x001D/0x001E), and the cyclic copy between SM buffers and
+// object values:
+//   outputs (SM type 3 in 0x1C00): the newest complete SM buffer is copied bit by bit into the
+//            values of the mapped RxPDO entries;
+//   inputs  (SM type 4): the mapped TxPDO entries' values are packed into the SM buffer.
+// Entries are packed LSB first in mapping order with no alignment (a gap entry, index 0, just
+// advances the offset), exactly as a master computes offsets from the same objects.
+//
+// Slaves without CoE (SII-only, e.g. an EL2004) use the same code with a dictionary built from
+// their ESI PDOs that no mailbox reaches.
+//
+// bind() allocates (done at PREOP->SAFEOP, off the cyclic path); readOutputs() and
+// writeInputs() never allocate.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "protocol/result.hpp"
+#include "slavesim/coe/object_dictionary.hpp"
+#include "slavesim/coe/standard_objects.hpp"
+#include "slavesim/slave.hpp"
+
+namespace ecsim::slavesim {
+
+struct ProcessDataSmLayout {
+  unsigned sm{0};
+  bool outputs{true};
+  std::uint32_t bitLength{0};
+  std::vector<coe::MappedObject> entries;  // in SM order, gaps included
+  std::uint16_t byteLength() const { return static_cast<std::uint16_t>((bitLength + 7) / 8); }
+};
+
+// The layout the current assignment and mappings give. Errors name the object that makes the
+// configuration unusable (an assigned PDO that does not exist, a mapped entry that does not
+// exist or is shorter than its mapping).
+Result<std::vector<ProcessDataSmLayout>> computeProcessDataLayout(const coe::ObjectDictionary& od);
+
+class ProcessDataBinding {
+ public:
+  // Recomputes the layout and the copy plan; the dictionary must outlive the binding and keep
+  // its objects (values may change, objects must not be replaced) until the next bind().
+  // On error the binding is empty (no SM expected, nothing copied).
+  Status bind(coe::ObjectDictionary& od);
+  const std::vector<ProcessDataSmLayout>& layout() const { return layout_; }
+  // Replaces profile.processData with the expected SM lengths.
+  void fillProfile(SlaveProfile& profile) const;
+
+  // Cyclic path (no allocation). readOutputs copies only SMs the master has written at least
+  // once; writeInputs writes every input SM.
+  void readOutputs(const Esc& esc);
+  void writeInputs(Esc& esc);
+
+ private:
+  struct Copy {
+    std::size_t buffer{0};       // index into buffers_
+    std::uint32_t bitOffset{0};  // in the SM
+    std::uint16_t bits{0};
+    std::uint8_t* value{nullptr};  // the entry's value bytes
+    std::size_t valueSize{0};
+  };
+  struct Buffer {
+    unsigned sm{0};
+    bool outputs{true};
+    std::vector<std::uint8_t> bytes;
+  };
+  std::vector<ProcessDataSmLayout> layout_;
+  std::vector<Buffer> buffers_;
+  std::vector<Copy> copies_;
+};
+
+// A device model that works on the object dictionary: called each firmware step between the
+// output copy and the input copy.
+class Application {
+ public:
+  virtual ~Application() = default;
+  virtual void step(coe::ObjectDictionary& od, AlState state, SimTime now) = 0;
+};
+
+// The Device of a dictionary-based slave: keeps the ESM's expectations up to date (rebinding
+// at every AL control write, so a PDO assignment changed in PREOP counts at PREOP->SAFEOP),
+// and in SAFEOP and OP copies outputs -> dictionary, runs the application, copies dictionary
+// -> inputs. Outputs are copied in SAFEOP too (the values an application sees are the newest
+// the master sent); an application decides itself what SAFEOP means for its actuators.
+class ProcessDataDevice final : public Device {
+ public:
+  explicit ProcessDataDevice(std::shared_ptr<coe::ObjectDictionary> od);
+
+  void updateProfile(SlaveProfile& profile) override;
+  void step(Esc& esc, AlState state, SimTime now) override;
+
+  coe::ObjectDictionary& dictionary() { return *od_; }
+  std::shared_ptr<coe::ObjectDictionary> sharedDictionary() { return od_; }
+  const ProcessDataBinding& binding() const { return binding_; }
+  // The outcome of the last bind (an unusable PDO configuration is reported here).
+  const Status& bindStatus() const { return bindStatus_; }
+  void setApplication(std::unique_ptr<Application> application) {
+    application_ = std::move(application);
+  }
+  Application* application() { return application_.get(); }
+
+ private:
+  std::shared_ptr<coe::ObjectDictionary> od_;
+  ProcessDataBinding binding_;
+  Status bindStatus_;
+  std::unique_ptr<Application> application_;
+};
+
+}  // namespace ecsim::slavesim
