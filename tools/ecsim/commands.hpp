@@ -12,5 +12,6 @@ using CommandRunner = std::function<int()>;
 CommandRunner addServeCommand(CLI::App& app);
 CommandRunner addDemoCommand(CLI::App& app);
 CommandRunner addNetCommand(CLI::App& app);
+CommandRunner addStudyCommand(CLI::App& app);
 
 }  // namespace ecsim::tools

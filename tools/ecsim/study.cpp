@@ -1,0 +1,134 @@
+// `ecsim study latency --out DIR`: round trip and minimum cycle per slave count, process-data
+// size and topology, with the simulator's own CPU cost; writes latency.csv, the gnuplot
+// script latency.gp and latency.png.
+#include <fmt/core.h>
+#include <fmt/ranges.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "link/netns.hpp"
+#include "tools/ecsim/commands.hpp"
+#include "topology/latency_study.hpp"
+
+namespace ecsim::tools {
+namespace {
+
+struct StudyOptions {
+  std::string out{"latency-study"};
+  std::size_t maxSlaves{1024};
+  std::vector<unsigned> bytes{1, 8, 32};
+  std::vector<std::string> topologies{"line", "tree"};
+  SimTime processingNs{1000};
+  SimTime forwardingNs{1000};
+  double cableMetres{1.0};
+};
+
+const char* kPlot =
+    R"(# gnuplot script written by `ecsim study latency`; edit and rerun: gnuplot latency.gp
+set datafile separator comma
+set key autotitle columnhead
+set terminal pngcairo size 1000,650 font ',11'
+set output 'latency.png'
+set title 'Modelled EtherCAT round trip vs slave count (100 Mbit/s)'
+set xlabel 'slaves'
+set ylabel 'round trip [us]'
+set logscale xy
+set grid
+set key left top
+set style data linespoints
+)";
+
+int runStudy(const StudyOptions& o) {
+  std::filesystem::create_directories(o.out);
+  const auto dir = std::filesystem::path(o.out);
+  std::ofstream csv(dir / "latency.csv");
+  csv << "topology,slaves,bytes_per_slave,frame_bytes,frames_per_cycle,modelled_round_trip_ns,"
+         "min_cycle_ns,sim_cpu_ns_per_cycle,closed_form_ns\n";
+  RealClock cpu;
+  const auto counts = topology::logSpacedCounts(o.maxSlaves);
+  const std::size_t total = counts.size() * o.bytes.size() * o.topologies.size();
+  std::size_t done = 0;
+  std::vector<std::string> series;
+  for (const auto& topo : o.topologies) {
+    if (topo != "line" && topo != "tree") {
+      fmt::print(stderr, "ecsim study: unknown topology '{}' (line, tree)\n", topo);
+      return 2;
+    }
+    for (unsigned b : o.bytes) {
+      series.push_back(fmt::format("{} {} B/slave", topo, b));
+      for (std::size_t n : counts) {
+        topology::StudyParameters p;
+        p.topology =
+            topo == "line" ? topology::StudyTopology::kLine : topology::StudyTopology::kTree;
+        p.slaves = n;
+        p.bytesPerSlave = static_cast<std::uint16_t>(b);
+        p.processingDelayNs = o.processingNs;
+        p.forwardingDelayNs = o.forwardingNs;
+        p.cableMetres = o.cableMetres;
+        p.repetitions = n >= 512 ? 5 : 20;
+        auto point = topology::runLatencyPoint(p, cpu);
+        if (!point.ok()) {
+          fmt::print(stderr, "ecsim study: {}\n", point.error().message());
+          return 1;
+        }
+        const bool closedForm =
+            p.topology == topology::StudyTopology::kLine && point->framesPerCycle == 1;
+        csv << fmt::format(
+            "{},{},{},{},{},{},{},{:.0f},{}\n", topo, n, b, point->frameBytes,
+            point->framesPerCycle, point->roundTripNs, point->minCycleNs, point->simCpuNsPerCycle,
+            closedForm ? std::to_string(topology::closedFormLineRoundTrip(p, point->frameBytes))
+                       : "");
+        ++done;
+        fmt::print("\r[{:3}/{}] {:4} {:5} slaves {:3} B: round trip {:9.1f} us, cpu {:8.1f} us{}",
+                   done, total, topo, n, b, static_cast<double>(point->roundTripNs) / 1000.0,
+                   point->simCpuNsPerCycle / 1000.0, point->wkcErrors ? "  WKC ERRORS" : "");
+        std::fflush(stdout);
+      }
+    }
+  }
+  csv.close();
+  fmt::print("\n");
+  std::ofstream gp(dir / "latency.gp");
+  gp << kPlot << "plot ";
+  for (std::size_t i = 0; i < series.size(); ++i) {
+    const auto& topo = o.topologies[i / o.bytes.size()];
+    const unsigned b = o.bytes[i % o.bytes.size()];
+    gp << (i ? ", \\\n     " : "")
+       << fmt::format(
+              "'latency.csv' using (strcol(1) eq '{}' && $3 == {} ? $2 : 1/0):($6/1000) title '{}'",
+              topo, b, series[i]);
+  }
+  gp << "\n";
+  gp.close();
+  auto plot = runCommand({"sh", "-c", "cd '" + dir.string() + "' && gnuplot latency.gp"});
+  if (!plot.ok() || plot->exitCode != 0) {
+    fmt::print(stderr, "ecsim study: gnuplot failed ({}); CSV and script are in {}\n",
+               plot.ok() ? plot->output : plot.error().message(), o.out);
+    return 1;
+  }
+  fmt::print("wrote {}/latency.csv, latency.gp, latency.png\n", o.out);
+  return 0;
+}
+
+}  // namespace
+
+CommandRunner addStudyCommand(CLI::App& app) {
+  auto opts = std::make_shared<StudyOptions>();
+  auto* study = app.add_subcommand("study", "Timing studies of simulated networks");
+  study->require_subcommand(1);
+  auto* latency = study->add_subcommand("latency", "Round trip per slave count and data size");
+  latency->add_option("--out", opts->out, "Output directory");
+  latency->add_option("--max-slaves", opts->maxSlaves, "Largest slave count (log-spaced up to it)")
+      ->check(CLI::Range(1, 4096));
+  latency->add_option("--bytes", opts->bytes, "Process-data bytes per slave (in and out)")
+      ->delimiter(',');
+  latency->add_option("--topology", opts->topologies, "line and/or tree")->delimiter(',');
+  latency->add_option("--processing-ns", opts->processingNs, "ESC processing delay");
+  latency->add_option("--forwarding-ns", opts->forwardingNs, "ESC forwarding delay");
+  latency->add_option("--cable", opts->cableMetres, "Cable length between slaves in metres");
+  return [opts] { return runStudy(*opts); };
+}
+
+}  // namespace ecsim::tools
