@@ -62,6 +62,11 @@ Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiDevice& device, std::st
                                sii.identity.revision, sii.identity.serial});
 
   auto pd = std::make_unique<ProcessDataDevice>(od);
+  std::uint32_t virtualSms = 0;
+  for (std::size_t n = 0; n < device.syncManagers.size() && n < 32; ++n) {
+    if (device.syncManagers[n].isVirtual) virtualSms |= 1u << n;
+  }
+  pd->setVirtualSyncManagers(virtualSms);
   pd->updateProfile(profile);
 
   auto slave =

@@ -8,7 +8,7 @@
 //              from the ESI <CoE> element); other protocols (and CoE, when the ESI mailbox
 //              has none) get "unsupported protocol" mailbox error replies;
 //   device     ProcessDataDevice over the same dictionary (also for SII-only slaves, whose
-//              dictionary no mailbox reaches).
+//              dictionary no mailbox reaches); ESI Virtual SMs are neither checked nor copied.
 // Bootstrap (BOOT state) and modules/slots are not modelled.
 #pragma once
 

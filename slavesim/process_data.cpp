@@ -69,7 +69,7 @@ Result<std::vector<ProcessDataSmLayout>> computeProcessDataLayout(const coe::Obj
   return out;
 }
 
-Status ProcessDataBinding::bind(coe::ObjectDictionary& od) {
+Status ProcessDataBinding::bind(coe::ObjectDictionary& od, std::uint32_t skip) {
   layout_.clear();
   buffers_.clear();
   copies_.clear();
@@ -79,6 +79,7 @@ Status ProcessDataBinding::bind(coe::ObjectDictionary& od) {
   for (const ProcessDataSmLayout& sm : layout_) {
     const std::size_t buffer = buffers_.size();
     buffers_.push_back({sm.sm, sm.outputs, std::vector<std::uint8_t>(sm.byteLength(), 0)});
+    if (sm.sm < 32 && (skip & (1u << sm.sm)) != 0) continue;
     std::uint32_t offset = 0;
     for (const coe::MappedObject& m : sm.entries) {
       if (m.index != 0 && m.bitLength > 0) {
@@ -91,9 +92,10 @@ Status ProcessDataBinding::bind(coe::ObjectDictionary& od) {
   return okStatus();
 }
 
-void ProcessDataBinding::fillProfile(SlaveProfile& profile) const {
+void ProcessDataBinding::fillProfile(SlaveProfile& profile, std::uint32_t unchecked) const {
   profile.processData.clear();
   for (const ProcessDataSmLayout& sm : layout_) {
+    if (sm.sm < 32 && (unchecked & (1u << sm.sm)) != 0) continue;
     profile.processData.push_back({sm.sm, sm.outputs, sm.byteLength()});
   }
 }
@@ -127,9 +129,9 @@ ProcessDataDevice::ProcessDataDevice(std::shared_ptr<coe::ObjectDictionary> od)
 }
 
 void ProcessDataDevice::updateProfile(SlaveProfile& profile) {
-  bindStatus_ = binding_.bind(*od_);
+  bindStatus_ = binding_.bind(*od_, virtualSms_);
   if (bindStatus_.ok()) {
-    binding_.fillProfile(profile);
+    binding_.fillProfile(profile, virtualSms_);
     return;
   }
   // An unusable PDO configuration: no SM configuration can satisfy the ESM, so
@@ -138,9 +140,10 @@ void ProcessDataDevice::updateProfile(SlaveProfile& profile) {
   if (const coe::Object* types = od_->find(coe::kSmTypesIndex); types != nullptr) {
     for (const coe::Entry& t : types->entries) {
       if (t.subindex == 0 || t.value.empty()) continue;
+      const unsigned sm = t.subindex - 1u;
+      if (sm < 32 && (virtualSms_ & (1u << sm)) != 0) continue;
       if (t.value[0] == coe::kSmTypeOutputs || t.value[0] == coe::kSmTypeInputs) {
-        profile.processData.push_back(
-            {t.subindex - 1u, t.value[0] == coe::kSmTypeOutputs, kUnusableLength});
+        profile.processData.push_back({sm, t.value[0] == coe::kSmTypeOutputs, kUnusableLength});
       }
     }
   }

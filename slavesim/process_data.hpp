@@ -44,11 +44,13 @@ class ProcessDataBinding {
  public:
   // Recomputes the layout and the copy plan; the dictionary must outlive the binding and keep
   // its objects (values may change, objects must not be replaced) until the next bind().
-  // On error the binding is empty (no SM expected, nothing copied).
-  Status bind(coe::ObjectDictionary& od);
+  // On error the binding is empty (no SM expected, nothing copied). SMs in `skip` (bit n =
+  // SM n) are laid out but not copied.
+  Status bind(coe::ObjectDictionary& od, std::uint32_t skip = 0);
   const std::vector<ProcessDataSmLayout>& layout() const { return layout_; }
-  // Replaces profile.processData with the expected SM lengths.
-  void fillProfile(SlaveProfile& profile) const;
+  // Replaces profile.processData with the expected SM lengths, leaving out the SMs in
+  // `unchecked` (bit n = SM n).
+  void fillProfile(SlaveProfile& profile, std::uint32_t unchecked = 0) const;
 
   // Cyclic path (no allocation). readOutputs copies only SMs the master has written at least
   // once; writeInputs writes every input SM.
@@ -98,6 +100,10 @@ class ProcessDataDevice final : public Device {
   const ProcessDataBinding& binding() const { return binding_; }
   // The outcome of the last bind (an unusable PDO configuration is reported here).
   const Status& bindStatus() const { return bindStatus_; }
+  // SMs the ESM does not check and the binding does not copy (bit n = SM n): ESI "Virtual"
+  // SMs, through which a master maps ESC registers (EL1252: latch status 0x09AE, system time
+  // 0x0910) rather than buffers the firmware fills.
+  void setVirtualSyncManagers(std::uint32_t mask) { virtualSms_ = mask; }
   void setApplication(std::unique_ptr<Application> application) {
     application_ = std::move(application);
   }
@@ -107,6 +113,7 @@ class ProcessDataDevice final : public Device {
   std::shared_ptr<coe::ObjectDictionary> od_;
   ProcessDataBinding binding_;
   Status bindStatus_;
+  std::uint32_t virtualSms_{0};
   std::unique_ptr<Application> application_;
 };
 

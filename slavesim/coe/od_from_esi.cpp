@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cstdlib>
 #include <optional>
+#include <set>
 
 #include "config/sii_builder.hpp"
 #include "slavesim/coe/standard_objects.hpp"
@@ -274,6 +275,8 @@ Object buildObject(const EsiObject& o, const EsiDictionary& dict) {
     object.dataType = t.dataType;
   }
   // Info/SubItem: by name, else by position.
+  const bool pdoObject = isPdoMappingIndex(object.index) || isPdoAssignIndex(object.index);
+  bool countLater = false;
   std::vector<bool> used(slots.size(), false);
   std::vector<const EsiSubItemInfo*> info(slots.size(), nullptr);
   for (std::size_t k = 0; k < o.subItems.size(); ++k) {
@@ -319,12 +322,25 @@ Object buildObject(const EsiObject& o, const EsiDictionary& dict) {
     const bool given = applyValueInfo(
         e, object.code == ObjectCode::kVar ? o.info : (si != nullptr ? si->info : EsiValueInfo{}));
     if (!given && object.code != ObjectCode::kVar && e.subindex == 0 && e.value.size() == 1) {
+      // No default given: sub 0 tells the highest subindex, or for PDO assignment and mapping
+      // objects (filled below) how many entries are in use.
       std::uint8_t highest = 0;
       for (const Slot& other : slots) highest = std::max(highest, other.entry.subindex);
-      e.value[0] = highest;  // no default given: sub 0 tells the highest subindex
+      e.value[0] = pdoObject ? 0 : highest;
       e.defaultValue = e.value;
+      countLater = pdoObject;
     }
     object.entries.push_back(std::move(e));
+  }
+  if (countLater) {  // sub 0 = the leading entries with a value
+    std::uint8_t n = 0;
+    for (const Entry& e : object.entries) {
+      if (e.subindex == 0) continue;
+      if (e.subindex != n + 1 || readRawValue(e.value, e.bitLength) == 0) break;
+      ++n;
+    }
+    object.entries.front().value[0] = n;
+    object.entries.front().defaultValue = object.entries.front().value;
   }
   return object;
 }
@@ -360,14 +376,31 @@ std::vector<MappedObject> mappingOf(const EsiPdo& pdo) {
   return out;
 }
 
-void addMappedObjects(ObjectDictionary& od, const EsiPdo& pdo, bool rx) {
+std::uint32_t key(const EsiPdoEntry& e) {
+  return (static_cast<std::uint32_t>(e.index) << 8) | e.subIndex;
+}
+
+// Entries this builder creates for PDO entries the dictionary lacks (keys of key()).
+void addMappedObjects(ObjectDictionary& od, const EsiPdo& pdo, bool rx,
+                      std::set<std::uint32_t>& created) {
   const std::uint16_t mappable = rx ? access::kRxMappable : access::kTxMappable;
   for (const auto& pe : pdo.entries) {
     if (pe.index == 0) continue;
     if (Entry* e = od.findEntry(pe.index, pe.subIndex); e != nullptr) {
       e->access |= mappable;
+      if (created.count(key(pe)) != 0 && e->bitLength < pe.bitLength) {
+        // Alternative PDOs map the same object with 32 or 64 bits (EL1252 NextLatchTime):
+        // the object we made up takes the longest.
+        e->bitLength = pe.bitLength;
+        e->value.resize(e->byteSize(), 0);
+        e->defaultValue.resize(e->byteSize(), 0);
+        if (e->dataType == data_type::kUnsigned32 && e->bitLength == 64) {
+          e->dataType = data_type::kUnsigned64;
+        }
+      }
       continue;
     }
+    created.insert(key(pe));
     std::uint16_t type = coeDataTypeCode(pe.dataType);
     if (type == 0 || (type == data_type::kBoolean && pe.bitLength > 1))
       type = typeForBits(pe.bitLength);
@@ -448,20 +481,39 @@ ObjectDictionary buildObjectDictionary(const EsiDevice& device, const OdBuildOpt
   if (!od.contains(kSmTypesIndex)) {
     std::vector<std::uint8_t> types;
     for (const auto& sm : device.syncManagers) types.push_back(smTypeOf(sm));
+    // The PDOs assigned to a process-data SM say its direction when its text is wrong (the
+    // SMC EX250 calls its input SM "Outputs"), as SOEM decides from the SII PDOs.
+    for (std::size_t n = 0; n < types.size(); ++n) {
+      if (types[n] != kSmTypeOutputs && types[n] != kSmTypeInputs) continue;
+      auto assignedTo = [n](const std::vector<EsiPdo>& pdos) {
+        return std::any_of(pdos.begin(), pdos.end(),
+                           [n](const EsiPdo& p) { return p.sm && *p.sm == n; });
+      };
+      const bool rx = assignedTo(device.rxPdos);
+      const bool tx = assignedTo(device.txPdos);
+      if (rx != tx) types[n] = rx ? kSmTypeOutputs : kSmTypeInputs;
+    }
     addSyncManagerTypes(od, types);
   }
 
   // PDO mapping objects and their rules.
+  std::set<std::uint32_t> created;
   const bool pdoConfig = device.mailbox.coeDetails.pdoConfig;
   for (int dir = 0; dir < 2; ++dir) {
     const bool rx = dir == 0;
     for (const EsiPdo& pdo : rx ? device.rxPdos : device.txPdos) {
+      if (!isPdoMappingIndex(pdo.index)) {
+        // EL1262 has a TxPdo 0x1C00, which would overwrite the SM types: CoE cannot name
+        // such a PDO, so it is left out (its SII PDO category still lists it).
+        note("PDO " + hex4(pdo.index) + " is outside 0x1600-0x17FF/0x1A00-0x1BFF: left out");
+        continue;
+      }
       PdoRules& rules = od.pdoRules(pdo.index);
       rules.fixed = pdo.fixed;
       rules.mandatory = pdo.mandatory;
       rules.defaultSm = pdo.sm;
       rules.excludes = pdo.excludes;
-      addMappedObjects(od, pdo, rx);
+      addMappedObjects(od, pdo, rx, created);
       std::vector<MappedObject> entries = mappingOf(pdo);
       if (Object* existing = od.find(pdo.index); existing != nullptr) {
         limitWritesToPreOp(*existing, pdo.fixed);
@@ -502,6 +554,7 @@ ObjectDictionary buildObjectDictionary(const EsiDevice& device, const OdBuildOpt
     std::vector<std::uint16_t> assigned;
     std::size_t candidates = 0;
     for (const EsiPdo& pdo : outputs ? device.rxPdos : device.txPdos) {
+      if (!isPdoMappingIndex(pdo.index)) continue;
       if (pdo.sm && *pdo.sm == sm) assigned.push_back(pdo.index);
       if (!pdo.sm || *pdo.sm == sm) ++candidates;
     }

@@ -33,7 +33,10 @@ SdoResult checkMappingEntry(const ObjectDictionary& od, std::uint16_t mappingInd
   if (m.index == 0) return kSdoOk;  // a gap
   const Entry* e = od.findEntry(m.index, m.subindex);
   const bool rx = isRxPdoMappingIndex(mappingIndex);
-  if (e == nullptr || (rx ? !e->rxMappable() : !e->txMappable()) || e->bitLength != m.bitLength) {
+  // A mapping may take fewer bits than the entry has (Beckhoff maps 64-bit latch times with 32
+  // bits in alternative PDOs); never more.
+  if (e == nullptr || (rx ? !e->rxMappable() : !e->txMappable()) || m.bitLength == 0 ||
+      m.bitLength > e->bitLength) {
     return abortCode(SdoAbortCode::kObjectCannotBeMapped);
   }
   return kSdoOk;

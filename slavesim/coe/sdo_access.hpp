@@ -9,7 +9,7 @@
 //   - an entry written while sub 0 != 0: 0x06010003 (subindex cannot be written, SI0 not 0);
 //   - sub 0 above the number of entries the object has: 0x06090031;
 //   - mapping entry naming an object that does not exist, is not mappable in this direction
-//     or has another bit length: 0x06040041 (object cannot be mapped);
+//     or has fewer bits than the mapping says: 0x06040041 (object cannot be mapped);
 //   - assignment entry that is not a mapping object of the SM's direction: 0x06090030;
 //   - assignment (sub 0 = n > 0) leaving out a Mandatory PDO of that SM, or combining PDOs
 //     that exclude each other: 0x06040043 (general parameter incompatibility).

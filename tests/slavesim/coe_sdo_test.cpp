@@ -113,8 +113,8 @@ TEST(CoeSdo, AbortCodes) {
   EXPECT_EQ(t.master->download(0x1600, 0, {0}), 0u);
   EXPECT_EQ(t.master->download(0x1600, 1, bytesOf(0x20010010, 4)), 0x06040041u)
       << "0x2001 is not RX mappable";
-  EXPECT_EQ(t.master->download(0x1600, 1, bytesOf(0x70000308, 4)), 0x06040041u)
-      << "wrong bit length";
+  EXPECT_EQ(t.master->download(0x1600, 1, bytesOf(0x70000120, 4)), 0x06040041u)
+      << "32 bits of a BOOL";
   EXPECT_EQ(t.master->download(0x1C12, 0, {0}), 0u);
   EXPECT_EQ(t.master->download(0x1C12, 1, bytesOf(0x1A00, 2)), 0x06090030u);
   EXPECT_EQ(t.master->download(0x1C12, 0, {3}), 0x06090031u) << "more than the 2 entries";

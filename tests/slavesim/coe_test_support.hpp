@@ -435,7 +435,8 @@ struct CoeTestSlave {
   }
 
   // Process-data SMs and FMMUs (outputs at logical 0, inputs after them), then SAFEOP.
-  std::uint16_t toSafeOp(std::uint16_t sm2Length = 3, std::uint16_t sm3Length = 4) {
+  std::uint16_t toSafeOp(std::uint16_t sm2Length = 3, std::uint16_t sm3Length = 4,
+                         std::uint16_t control = 0x0004) {
     one(seg, Command::kFpwr, phys(kStation, reg::smChannel(2)),
         smRegisterBytes(kSm2Start, sm2Length, 0x64));
     one(seg, Command::kFpwr, phys(kStation, reg::smChannel(3)),
@@ -444,7 +445,7 @@ struct CoeTestSlave {
         fmmuRegisterBytes(0, sm2Length, kSm2Start, 2));
     one(seg, Command::kFpwr, phys(kStation, reg::fmmuChannel(1)),
         fmmuRegisterBytes(sm2Length, sm3Length, kSm3Start, 1));
-    requestState(seg, kStation, 0x0004);
+    requestState(seg, kStation, control);
     return alStatus(seg, kStation);
   }
 };
