@@ -1,5 +1,6 @@
 #include "topology/network_builder.hpp"
 
+#include "slavesim/esi_slave.hpp"
 #include "slavesim/generic_slave.hpp"
 
 namespace ecsim::topology {
@@ -11,30 +12,76 @@ const CableRef* Network::findCable(std::string_view name) const {
   return nullptr;
 }
 
-Result<std::unique_ptr<slavesim::Slave>> makeTopologySlave(const TopologySlave& entry) {
-  auto esc = slavesim::escTypeByName(entry.esc);
-  if (!esc) {
-    return makeError(ErrorCode::kInvalidArgument, "line " + std::to_string(entry.line) +
-                                                      ": unknown ESC type '" + entry.esc +
-                                                      "' (ET1100, ET1200, LAN9252)");
-  }
-  if (entry.builtin == "generic") {
-    return slavesim::makeGenericSlave(entry.name, static_cast<std::uint32_t>(entry.line), *esc);
-  }
-  if (!entry.builtin.empty()) {
-    return makeError(ErrorCode::kNotFound, "line " + std::to_string(entry.line) +
-                                               ": unknown built-in device '" + entry.builtin + "'");
-  }
-  return makeError(ErrorCode::kUnsupported,
-                   "line " + std::to_string(entry.line) + ": ESI devices need slavesim/esi_slave");
+namespace {
+
+Error at(const TopologySlave& entry, std::string message) {
+  return makeError(ErrorCode::kInvalidArgument,
+                   "line " + std::to_string(entry.line) + ": " + std::move(message));
 }
 
-Result<Network> buildNetwork(const TopologyConfig& config, const SlaveMaker& maker) {
+}  // namespace
+
+Result<std::unique_ptr<slavesim::Slave>> SlaveFactory::make(const TopologySlave& entry) {
+  std::optional<slavesim::EscType> esc;
+  if (!entry.esc.empty()) {
+    esc = slavesim::escTypeByName(entry.esc);
+    if (!esc) return at(entry, "unknown ESC type '" + entry.esc + "' (ET1100, ET1200, LAN9252)");
+  }
+  if (entry.builtin == "generic") {
+    return slavesim::makeGenericSlave(entry.name, static_cast<std::uint32_t>(entry.line),
+                                      esc.value_or(slavesim::kEt1100));
+  }
+  if (!entry.builtin.empty()) return at(entry, "unknown built-in device '" + entry.builtin + "'");
+  auto found = esiFiles_.find(entry.esiFile);
+  if (found == esiFiles_.end()) {
+    auto file = loadEsiFile(entry.esiFile);
+    if (!file.ok()) return file.takeError();
+    found = esiFiles_.emplace(entry.esiFile, std::move(file).value()).first;
+  }
+  const EsiFile& file = found->second;
+  const EsiDevice* device = nullptr;
+  for (const auto& d : file.devices) {
+    if (!d.hasProductCode || d.productCode != *entry.productCode) continue;
+    if (entry.revision ? d.revision == *entry.revision
+                       : (device == nullptr || d.revision > device->revision)) {
+      device = &d;
+    }
+  }
+  if (device == nullptr) {
+    return at(entry,
+              "no device with product code " + std::to_string(*entry.productCode) +
+                  (entry.revision ? " and revision " + std::to_string(*entry.revision) : "") +
+                  " in " + entry.esiFile.string());
+  }
+  slavesim::EsiSlaveOptions options;
+  options.escType = esc;
+  options.serial = static_cast<std::uint32_t>(entry.line);
+  auto slave = slavesim::makeSlaveFromEsi(file, *device, entry.name, options);
+  if (!slave.ok()) return slave;
+  if (auto* od = slavesim::objectDictionaryOf(**slave)) {
+    for (const auto& input : entry.inputs) {
+      const auto* e = od->findEntry(input.index, input.subIndex);
+      if (e == nullptr) {
+        return at(entry, "input " + std::to_string(input.index) + ":" +
+                             std::to_string(input.subIndex) + " is not in the device's dictionary");
+      }
+      std::array<std::uint8_t, 8> raw{};
+      writeLe64(raw, 0, static_cast<std::uint64_t>(input.value));
+      ECSIM_TRY(od->setBytes(input.index, input.subIndex, ConstBytes(raw.data(), e->byteSize())));
+    }
+  } else if (!entry.inputs.empty()) {
+    return at(entry, "this device has no objects to set inputs on");
+  }
+  return slave;
+}
+
+Result<Network> buildNetwork(const TopologyConfig& config) {
+  SlaveFactory factory;
   Network net;
   net.segment = std::make_unique<Segment>();
   Segment& seg = *net.segment;
   for (const auto& entry : config.slaves) {
-    auto slave = maker(entry);
+    auto slave = factory.make(entry);
     if (!slave.ok()) {
       Error e = slave.takeError();
       e.context = config.file.string() + ", slave '" + entry.name + "': " + e.context;

@@ -3,11 +3,13 @@
 // lengths, initial inputs. Cable names are kept so captures and faults can address cables.
 #pragma once
 
-#include <functional>
+#include <filesystem>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "config/esi.hpp"
 #include "config/topology_file.hpp"
 #include "protocol/result.hpp"
 #include "topology/segment.hpp"
@@ -26,12 +28,16 @@ struct Network {
   const CableRef* findCable(std::string_view name) const;
 };
 
-// Makes the slave a topology entry describes; the default handles built-in devices and ESI
-// devices (see slavesim/esi_slave.hpp).
-using SlaveMaker = std::function<Result<std::unique_ptr<slavesim::Slave>>(const TopologySlave&)>;
-Result<std::unique_ptr<slavesim::Slave>> makeTopologySlave(const TopologySlave& entry);
+// Makes the slaves topology entries describe: built-in devices, and devices from ESI files
+// (slavesim/esi_slave.hpp), reading each ESI file once.
+class SlaveFactory {
+ public:
+  Result<std::unique_ptr<slavesim::Slave>> make(const TopologySlave& entry);
 
-Result<Network> buildNetwork(const TopologyConfig& config,
-                             const SlaveMaker& maker = makeTopologySlave);
+ private:
+  std::map<std::filesystem::path, EsiFile> esiFiles_;
+};
+
+Result<Network> buildNetwork(const TopologyConfig& config);
 
 }  // namespace ecsim::topology

@@ -2,6 +2,8 @@
 // TAP device, or a real NIC) as a line of simulated slaves.
 #include <fmt/core.h>
 
+#include <cstdlib>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -29,10 +31,20 @@ struct ServeOptions {
   std::string tap;
   std::string netns;
   std::string pcap;
-  unsigned slaves{1};
+  unsigned slaves{0};  // 0: not given
   bool paced{false};
   bool quiet{false};
 };
+
+// The built-in demo network: the installed copy, else the one in the source tree.
+std::string defaultTopologyPath() {
+  if (const char* dir = std::getenv("ECSIM_DATA_DIR")) {
+    return (std::filesystem::path(dir) / "topologies" / "demo.xml").string();
+  }
+  const std::filesystem::path installed = ECSIM_INSTALLED_DATA_DIR "/topologies/demo.xml";
+  if (std::filesystem::exists(installed)) return installed.string();
+  return ECSIM_SOURCE_DATA_DIR "/topologies/demo.xml";
+}
 
 int runServe(ServeOptions o) {
   if (static_cast<int>(!o.iface.empty()) + static_cast<int>(!o.tap.empty()) +
@@ -76,6 +88,7 @@ int runServe(ServeOptions o) {
   }
 
   topology::Network network;
+  if (o.topology.empty() && o.slaves == 0) o.topology = defaultTopologyPath();
   if (!o.topology.empty()) {
     auto config = loadTopologyFile(o.topology);
     if (!config.ok()) {
@@ -162,13 +175,15 @@ int runServe(ServeOptions o) {
 CommandRunner addServeCommand(CLI::App& app) {
   auto opts = std::make_shared<ServeOptions>();
   auto* cmd = app.add_subcommand("serve", "Answer an EtherCAT master on a network interface");
-  cmd->add_option("topology", opts->topology, "Topology file (default: a line of --slaves)");
+  cmd->add_option(
+      "topology", opts->topology,
+      "Topology file (default: the demo network, or a line of --slaves generic slaves)");
   cmd->add_option("--pcap-link", opts->pcapLinks, "Capture the cable NAME to FILE (NAME=FILE)");
   cmd->add_option("--iface", opts->iface, "Interface to serve (e.g. one end of a veth pair)");
   cmd->add_option("--veth", opts->veth, "Create veth pair NAME for this run (master end NAME)");
   cmd->add_option("--tap", opts->tap, "Create/open this TAP device and serve on it");
   cmd->add_option("--netns", opts->netns, "Open the interface inside this network namespace");
-  cmd->add_option("--slaves", opts->slaves, "Number of generic slaves in a line")
+  cmd->add_option("--slaves", opts->slaves, "Serve a line of N generic slaves instead")
       ->check(CLI::Range(1u, 65535u));
   cmd->add_option("--pcap", opts->pcap, "Capture every frame to this pcap file");
   cmd->add_flag("--paced", opts->paced, "Answer at the modelled round-trip time");
