@@ -7,140 +7,22 @@
 #include <set>
 
 #include "config/sii_builder.hpp"
+#include "slavesim/coe/od_esi_detail.hpp"
 #include "slavesim/coe/standard_objects.hpp"
 
 namespace ecsim::slavesim::coe {
 namespace {
 
-std::string upper(std::string_view s) {
-  std::string out(trimEsiText(s));
-  for (auto& c : out) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-  return out;
-}
+using esi_detail::clampBits;
+using esi_detail::pdoBits;
+using esi_detail::typeForBits;
+using esi_detail::upperAscii;
 
 std::string hex4(std::uint32_t v) {
   constexpr char kDigits[] = "0123456789ABCDEF";
   std::string s = "0x";
   for (int shift = 12; shift >= 0; shift -= 4) s += kDigits[(v >> shift) & 0xF];
   return s;
-}
-
-std::uint16_t defaultBits(std::uint16_t code) {
-  namespace dt = data_type;
-  switch (code) {
-    case dt::kBoolean:
-      return 1;
-    case dt::kInteger8:
-    case dt::kUnsigned8:
-    case dt::kByte:
-      return 8;
-    case dt::kInteger16:
-    case dt::kUnsigned16:
-    case dt::kWord:
-      return 16;
-    case dt::kInteger24:
-    case dt::kUnsigned24:
-      return 24;
-    case dt::kInteger32:
-    case dt::kUnsigned32:
-    case dt::kReal32:
-    case dt::kDword:
-      return 32;
-    case dt::kInteger64:
-    case dt::kUnsigned64:
-    case dt::kReal64:
-      return 64;
-    default:
-      break;
-  }
-  if (code >= dt::kBit1 && code <= dt::kBit8)
-    return static_cast<std::uint16_t>(code - dt::kBit1 + 1);
-  return 0;
-}
-
-bool isIntegerCode(std::uint16_t code) {
-  return defaultBits(code) > 0 && !isRealType(code);
-}
-
-std::uint16_t typeForBits(std::uint32_t bits) {
-  if (bits == 1) return data_type::kBoolean;
-  if (bits > 1 && bits < 8) return data_type::bitType(bits);
-  switch (bits) {
-    case 8:
-      return data_type::kUnsigned8;
-    case 16:
-      return data_type::kUnsigned16;
-    case 24:
-      return data_type::kUnsigned24;
-    case 32:
-      return data_type::kUnsigned32;
-    case 64:
-      return data_type::kUnsigned64;
-    default:
-      return data_type::kOctetString;
-  }
-}
-
-std::uint16_t clampBits(std::uint32_t bits) {
-  return static_cast<std::uint16_t>(std::min<std::uint32_t>(bits, 0xFFFF));
-}
-
-ResolvedType resolve(const EsiDictionary& dict, std::string_view typeName, std::uint32_t hint,
-                     int depth) {
-  const std::string name = upper(typeName);
-  if (name.rfind("STRING", 0) == 0) {
-    return {data_type::kVisibleString, clampBits(hint)};
-  }
-  if (std::uint16_t code = coeDataTypeCode(name); code != 0) {
-    const std::uint16_t bits = hint != 0 ? clampBits(hint) : defaultBits(code);
-    if (code == data_type::kBoolean && bits > 1) return {typeForBits(bits), bits};
-    return {code, bits};
-  }
-  const EsiDataType* dt = depth < 8 ? dict.findDataType(trimEsiText(typeName)) : nullptr;
-  if (dt != nullptr && !dt->isRecord()) {
-    const std::uint32_t bits = dt->bitSize != 0 ? dt->bitSize : hint;
-    if (dt->isArray()) return {data_type::kOctetString, clampBits(bits)};
-    ResolvedType base = resolve(dict, dt->baseType, bits, depth + 1);
-    if (bits > 0 && bits < 8 && isIntegerCode(base.dataType)) {
-      return {typeForBits(bits), clampBits(bits)};
-    }
-    return {base.dataType, clampBits(bits != 0 ? bits : base.bitLength)};
-  }
-  // Vendor decorations such as "UINT_hex", "UDINT_hex".
-  if (auto cut = name.find('_'); cut != std::string::npos && cut > 0) {
-    if (std::uint16_t code = coeDataTypeCode(name.substr(0, cut)); code != 0) {
-      return {code, hint != 0 ? clampBits(hint) : defaultBits(code)};
-    }
-  }
-  return {typeForBits(hint), clampBits(hint)};
-}
-
-std::uint16_t stateBits(std::string_view restrictions, bool write) {
-  const std::uint16_t pre = write ? kAccessWritePreOp : kAccessReadPreOp;
-  const std::uint16_t safe = write ? kAccessWriteSafeOp : kAccessReadSafeOp;
-  const std::uint16_t op = write ? kAccessWriteOp : kAccessReadOp;
-  if (trimEsiText(restrictions).empty()) return static_cast<std::uint16_t>(pre | safe | op);
-  std::uint16_t bits = 0;
-  std::string token;
-  const std::string text = upper(restrictions) + "_";
-  for (char c : text) {
-    if (c == '_' || c == ',' || c == ' ') {
-      if (token == "PREOP") bits |= pre;
-      if (token == "SAFEOP") bits |= safe;
-      if (token == "OP") bits |= op;
-      token.clear();
-    } else {
-      token += c;
-    }
-  }
-  return bits;
-}
-
-std::uint16_t pdoBits(const EsiFlags& flags) {
-  std::uint16_t bits = 0;
-  if (flags.rxMappable()) bits |= access::kRxMappable;
-  if (flags.txMappable()) bits |= access::kTxMappable;
-  return bits;
 }
 
 // A number (or text for strings) in the entry's wire format.
@@ -235,7 +117,7 @@ Object buildObject(const EsiObject& o, const EsiDictionary& dict) {
   auto expandArray = [&](const EsiDataType& array, std::uint32_t totalBits, std::uint32_t firstSub,
                          const std::string& name, const EsiFlags* flags) {
     const std::uint32_t n = array.arrays.front().elements;
-    ResolvedType t = resolve(dict, array.baseType, 0, 0);
+    ResolvedType t = resolveEsiType(dict, array.baseType, 0);
     if (t.bitLength == 0 && n != 0) t.bitLength = clampBits(totalBits / n);
     for (std::uint32_t i = 0; i < n && firstSub + i <= 255; ++i) {
       slots.push_back(
@@ -254,22 +136,22 @@ Object buildObject(const EsiObject& o, const EsiDictionary& dict) {
         expandArray(*sdt, sit.bitSize, lbound >= 1 ? static_cast<std::uint32_t>(lbound) : 1,
                     sit.name, &sit.flags);
       } else {
-        slots.push_back(makeSlot(sit.subIndex, resolve(dict, sit.type, sit.bitSize, 0), sit.bitSize,
-                                 sit.name, &sit.flags, false));
+        slots.push_back(makeSlot(sit.subIndex, resolveEsiType(dict, sit.type, sit.bitSize),
+                                 sit.bitSize, sit.name, &sit.flags, false));
       }
     }
     object.code =
         expanded && !isPdoMappingIndex(object.index) ? ObjectCode::kArray : ObjectCode::kRecord;
     object.dataType = object.code == ObjectCode::kArray ? elementType : recordTypeFor(object.index);
-  } else if (dt != nullptr && dt->isArray() && upper(dt->baseType) != "BYTE" &&
-             upper(dt->baseType) != "USINT") {
+  } else if (dt != nullptr && dt->isArray() && upperAscii(dt->baseType) != "BYTE" &&
+             upperAscii(dt->baseType) != "USINT") {
     slots.push_back(
         makeSlot(0, {data_type::kUnsigned8, 8}, 8, "Number of entries", nullptr, false));
     expandArray(*dt, dt->bitSize, 1, object.name, nullptr);
     object.code = ObjectCode::kArray;
     object.dataType = elementType;
   } else {
-    ResolvedType t = resolve(dict, o.type, o.bitSize, 0);
+    ResolvedType t = resolveEsiType(dict, o.type, o.bitSize);
     slots.push_back(makeSlot(0, t, o.bitSize, object.name, nullptr, false));
     object.code = ObjectCode::kVar;
     object.dataType = t.dataType;
@@ -346,7 +228,7 @@ Object buildObject(const EsiObject& o, const EsiDictionary& dict) {
 }
 
 std::uint8_t smTypeOf(const EsiSyncManager& sm) {
-  const std::string text = upper(sm.text);
+  const std::string text = upperAscii(sm.text);
   if (text == "MBOXOUT") return kSmTypeMailboxOut;
   if (text == "MBOXIN") return kSmTypeMailboxIn;
   if (text == "OUTPUTS") return kSmTypeOutputs;
@@ -424,29 +306,6 @@ void addMappedObjects(ObjectDictionary& od, const EsiPdo& pdo, bool rx,
 }
 
 }  // namespace
-
-ResolvedType resolveEsiType(const EsiDictionary& dictionary, std::string_view typeName,
-                            std::uint32_t bitSizeHint) {
-  return resolve(dictionary, typeName, bitSizeHint, 0);
-}
-
-std::uint16_t accessFromEsiFlags(const EsiFlags& flags) {
-  std::uint16_t bits = 0;
-  switch (flags.access) {
-    case EsiAccess::kUnspecified:
-    case EsiAccess::kReadOnly:
-      bits = stateBits(flags.readRestrictions, false);
-      break;
-    case EsiAccess::kReadWrite:
-      bits = static_cast<std::uint16_t>(stateBits(flags.readRestrictions, false) |
-                                        stateBits(flags.writeRestrictions, true));
-      break;
-    case EsiAccess::kWriteOnly:
-      bits = stateBits(flags.writeRestrictions, true);
-      break;
-  }
-  return static_cast<std::uint16_t>(bits | pdoBits(flags));
-}
 
 ObjectDictionary buildObjectDictionary(const EsiDevice& device, const OdBuildOptions& options,
                                        OdBuildReport* report) {

@@ -237,5 +237,175 @@ TEST(EsiSlave, EveryDeviceOfEveryEsiFileIsDrivenAsFarAsItAllows) {
   EXPECT_GT(devices, 150);
 }
 
+// ---- single devices ----------------------------------------------------------------------------
+
+const EsiDevice* findDevice(const EsiFile& file, std::string_view type, std::uint32_t revision) {
+  for (const auto& d : file.devices) {
+    if (d.type == type && d.revision == revision) return &d;
+  }
+  return nullptr;
+}
+
+std::unique_ptr<slavesim::Slave> build(const EsiFile& file, const EsiDevice& device) {
+  auto slave = slavesim::makeSlaveFromEsi(file, device, device.type);
+  EXPECT_TRUE(slave.ok()) << (slave.ok() ? "" : slave.error().message());
+  return slave.ok() ? std::move(slave).value() : nullptr;
+}
+
+MailboxMaster mailboxMasterFor(topology::Segment& seg) {
+  const auto& m = *seg.slave(0).profile().mailbox;
+  return MailboxMaster(seg, kStation, m.outStart, m.outSize, m.inStart, m.inSize);
+}
+
+TEST(EsiSlave, StmblServoThroughFramesFromSdoToProcessData) {
+  const auto path = esiDir() / "STMBL_ECAT.xml";
+  ECSIM_REQUIRE_SHARED(path);
+  auto file = loadEsiFile(path);
+  ASSERT_TRUE(file.ok());
+  auto slave = build(*file, file->devices.at(0));
+  ASSERT_NE(slave, nullptr);
+  EXPECT_EQ(slave->esc().type().kind, slavesim::EscKind::kLan9252) << "4 SMs, 2 ports";
+  slavesim::coe::ObjectDictionary* od = slavesim::objectDictionaryOf(*slave);
+  ASSERT_NE(od, nullptr);
+  ASSERT_NE(slavesim::coeServerOf(*slave), nullptr);
+  topology::Segment seg;
+  seg.addSlave(std::move(slave));
+  const Outcome o = driveLikeSoem(seg);
+  ASSERT_EQ(o.reached, AlState::kOp) << o.reason;
+  EXPECT_TRUE(o.coeMapping);
+  EXPECT_EQ(o.outBytes, 6);
+  EXPECT_EQ(o.inBytes, 6);
+
+  MailboxMaster master = mailboxMasterFor(seg);
+  EXPECT_EQ(master.uploadValue<std::uint32_t>(0x1018, 2), 0x20192u) << "as in the SII";
+  EXPECT_EQ(master.uploadValue<std::uint32_t>(0x1018, 1), 4919u);
+  Upload name = master.upload(0x1008, 0);
+  EXPECT_EQ(name.command, 0x41);
+  EXPECT_EQ(std::string(name.data.begin(), name.data.end()), "STMBL ECAT");
+  EXPECT_EQ(master.upload(0x1C12, 0, true).abort, 0x06010004u) << "CompleteAccess=false";
+  auto list = master.info(OdListRequest{1});
+  ASSERT_TRUE(list.response);
+  EXPECT_EQ(std::get<OdList>(*list.response).indexes.size(), 23u);
+
+  // Process data: 0x6040 (16) + 0x607A (32) out, 0x6041 (16) + 0x6064 (32) in.
+  ASSERT_TRUE(od->set<std::uint16_t>(0x6041, 0, 0x0237).ok());
+  ASSERT_TRUE(od->set<std::int32_t>(0x6064, 0, -123456).ok());
+  seg.pollSlaves(0);
+  std::vector<std::uint8_t> frame(12, 0);
+  writeLe16(frame, 0, 0x000F);
+  writeLe32(frame, 2, 1000);
+  auto r = one(seg, Command::kLrw, 0, frame);
+  EXPECT_EQ(r.wkc, 3);
+  EXPECT_EQ(readLe16(r.data, 6), 0x0237);
+  EXPECT_EQ(static_cast<std::int32_t>(readLe32(r.data, 8)), -123456);
+  EXPECT_EQ(od->get<std::uint16_t>(0x6040, 0).value(), 0x000F);
+  EXPECT_EQ(od->get<std::int32_t>(0x607A, 0).value(), 1000);
+}
+
+TEST(EsiSlave, SiiOnlyInputTerminalUsesAnInternalDictionary) {
+  const auto path = esiDir() / "Beckhoff_EL1xxx_2011.xml";
+  ECSIM_REQUIRE_SHARED(path);
+  auto file = loadEsiFile(path);
+  ASSERT_TRUE(file.ok());
+  const EsiDevice* el1004 = findDevice(*file, "EL1004", 0x00100000);
+  ASSERT_NE(el1004, nullptr);
+  auto slave = build(*file, *el1004);
+  ASSERT_NE(slave, nullptr);
+  EXPECT_EQ(slavesim::coeServerOf(*slave), nullptr) << "no mailbox: nothing answers CoE";
+  slavesim::coe::ObjectDictionary* od = slavesim::objectDictionaryOf(*slave);
+  ASSERT_NE(od, nullptr);
+  topology::Segment seg;
+  seg.addSlave(std::move(slave));
+  const Outcome o = driveLikeSoem(seg);
+  ASSERT_EQ(o.reached, AlState::kOp) << o.reason;
+  EXPECT_FALSE(o.coeMapping);
+  EXPECT_EQ(o.inBytes, 1);
+  // Channels 2 and 4 (0x6010:01, 0x6030:01) are bits 1 and 3 of the input byte.
+  ASSERT_TRUE(od->set<bool>(0x6010, 1, true).ok());
+  ASSERT_TRUE(od->set<bool>(0x6030, 1, true).ok());
+  seg.pollSlaves(0);
+  auto r = one(seg, Command::kLrw, 0, {0});
+  EXPECT_EQ(r.wkc, 1);
+  EXPECT_EQ(r.data[0], 0x0A);
+}
+
+TEST(EsiSlave, MailboxWithoutCoeAnswersUnsupportedProtocol) {
+  const auto path = esiDir() / "Beckhoff_EtherCAT_Terminals.xml";
+  ECSIM_REQUIRE_SHARED(path);
+  auto file = loadEsiFile(path);
+  ASSERT_TRUE(file.ok());
+  const EsiDevice* el4102 = findDevice(*file, "EL4102", 0x270B0000);
+  ASSERT_NE(el4102, nullptr);
+  ASSERT_FALSE(el4102->mailbox.coe);
+  auto slave = build(*file, *el4102);
+  ASSERT_NE(slave, nullptr);
+  slavesim::coe::ObjectDictionary* od = slavesim::objectDictionaryOf(*slave);
+  topology::Segment seg;
+  seg.addSlave(std::move(slave));
+  const Outcome o = driveLikeSoem(seg);
+  ASSERT_EQ(o.reached, AlState::kOp) << o.reason;
+  EXPECT_EQ(o.outBytes, 4);
+  auto r = one(seg, Command::kLrw, 0, {0x34, 0x12, 0x78, 0x56});
+  EXPECT_EQ(r.wkc, 2);
+  seg.pollSlaves(0);
+  EXPECT_EQ(od->get<std::uint16_t>(0x6411, 1).value(), 0x1234);
+  EXPECT_EQ(od->get<std::uint16_t>(0x6411, 2).value(), 0x5678);
+  MailboxMaster master = mailboxMasterFor(seg);
+  auto reply = master.transact(master.sdoRequest(SdoInitiateUploadRequest{0x1018, 2, false}));
+  ASSERT_TRUE(reply);
+  EXPECT_EQ((*reply)[5] & 0x0F, 0) << "mailbox error";
+  EXPECT_EQ(readLe16(*reply, 8), 0x0002) << "unsupported protocol";
+}
+
+TEST(EsiSlave, VendorEepromImageIsUsedAsItIs) {
+  const std::vector<std::uint8_t> image = makeSii(0x1337, 0x55, 0x1000, 64, 0x1040, 64);
+  std::string hexImage;
+  for (std::uint8_t b : image) {
+    constexpr char kDigits[] = "0123456789ABCDEF";
+    hexImage += kDigits[b >> 4];
+    hexImage += kDigits[b & 0x0F];
+  }
+  const std::string xml = R"(<EtherCATInfo><Vendor><Id>#x1337</Id></Vendor><Descriptions><Devices>
+    <Device Physics="YY"><Type ProductCode="#x55" RevisionNo="#x1">Imaged</Type><Name>Imaged</Name>
+    <Sm StartAddress="#x1000" ControlByte="#x26" Enable="1" DefaultSize="128">MBoxOut</Sm>
+    <Sm StartAddress="#x1080" ControlByte="#x22" Enable="1" DefaultSize="128">MBoxIn</Sm>
+    <Mailbox><CoE/></Mailbox><Eeprom><Data>)" +
+                          hexImage +
+                          R"(</Data></Eeprom></Device></Devices></Descriptions></EtherCATInfo>)";
+  auto file = parseEsi(xml, "imaged.xml");
+  ASSERT_TRUE(file.ok()) << file.error().message();
+  auto slave = build(*file, file->devices.at(0));
+  ASSERT_NE(slave, nullptr);
+  EXPECT_EQ(slave->esc().sii(), image);
+  ASSERT_TRUE(slave->profile().mailbox.has_value());
+  EXPECT_EQ(slave->profile().mailbox->outSize, 64) << "the image's mailbox, not the ESI's";
+  EXPECT_EQ(slave->profile().mailbox->inStart, 0x1040);
+  EXPECT_EQ(slavesim::objectDictionaryOf(*slave)->get<std::uint32_t>(0x1018, 4).value(), 0x1234u)
+      << "0x1018 follows the image's serial";
+}
+
+TEST(EsiSlave, EscTypeFollowsTheDevicesNeeds) {
+  const auto ek = esiDir() / "Beckhoff_EK11xx.xml";
+  const auto ur20 = esiDir() / "Weidmueller_UR20_FBC.xml";
+  const auto stmbl = esiDir() / "STMBL_ECAT.xml";
+  ECSIM_REQUIRE_SHARED(ek);
+  ECSIM_REQUIRE_SHARED(ur20);
+  ECSIM_REQUIRE_SHARED(stmbl);
+  auto couplers = loadEsiFile(ek);
+  auto fbc = loadEsiFile(ur20);
+  auto servo = loadEsiFile(stmbl);
+  ASSERT_TRUE(couplers.ok() && fbc.ok() && servo.ok());
+  const EsiDevice* ek1100 = findDevice(*couplers, "EK1100", 0x00100000);
+  ASSERT_NE(ek1100, nullptr);
+  EXPECT_EQ(slavesim::chooseEscType(*ek1100).kind, slavesim::EscKind::kEt1100) << "3 ports";
+  EXPECT_EQ(slavesim::chooseEscType(fbc->devices.at(0)).kind, slavesim::EscKind::kEt1100)
+      << "inputs SM at 0x2400, beyond 4 KB";
+  EXPECT_EQ(slavesim::chooseEscType(servo->devices.at(0)).kind, slavesim::EscKind::kLan9252);
+  slavesim::EsiSlaveOptions options;
+  options.escType = slavesim::kEt1200;
+  auto slave = slavesim::makeSlaveFromEsi(*servo, servo->devices.at(0), "stmbl", options);
+  ASSERT_TRUE(slave.ok());
+  EXPECT_EQ((*slave)->esc().type().kind, slavesim::EscKind::kEt1200) << "the caller decides";
+}
 }  // namespace
 }  // namespace ecsim::testing
