@@ -1,0 +1,71 @@
+#include "master/bus.hpp"
+
+#include <poll.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <ctime>
+#include <string>
+
+namespace ecsim::master {
+namespace {
+
+// Without a file descriptor to sleep on, a real-time wait sleeps in slices this long.
+constexpr SimTime kSleepSlice = 100 * kNsPerUs;
+
+timespec toTimespec(SimTime ns) {
+  timespec ts{};
+  ts.tv_sec = static_cast<time_t>(ns / kNsPerSecond);
+  ts.tv_nsec = static_cast<long>(ns % kNsPerSecond);
+  return ts;
+}
+
+}  // namespace
+
+void RealTimeBus::wait(SimTime deadline) {
+  const SimTime remaining = deadline - clock_.now();
+  if (remaining <= 0) return;
+  const int fd = link_.pollFd();
+  if (fd >= 0) {
+    pollfd p{fd, POLLIN, 0};
+    const timespec ts = toTimespec(remaining);
+    (void)::ppoll(&p, 1, &ts, nullptr);  // EINTR: return early, the caller loops
+    return;
+  }
+  const timespec ts = toTimespec(std::min(remaining, kSleepSlice));
+  (void)::nanosleep(&ts, nullptr);
+}
+
+void VirtualBus::wait(SimTime deadline) {
+  const SimTime now = clock_.now();
+  if (auto roundTrip = peer_(now)) {
+    clock_.advance(std::max<SimTime>(1, *roundTrip));
+    return;
+  }
+  if (deadline > now) {
+    clock_.set(deadline);
+    (void)peer_(deadline);  // the firmware runs at the new time
+  }
+}
+
+Status runTask(Task& task, Transport& transport, Bus& bus, SimTime timeout, std::string_view what) {
+  const SimTime start = bus.now();
+  const SimTime deadline = start + timeout;
+  for (;;) {
+    const SimTime now = bus.now();
+    transport.poll(now);
+    const bool running = task.step(now);
+    transport.poll(now);  // send what the step queued
+    if (!running) return okStatus();
+    if (now >= deadline) {
+      return makeError(ErrorCode::kTimeout, std::string(what) + ": not finished after " +
+                                                std::to_string((now - start) / kNsPerMs) + " ms");
+    }
+    SimTime next = deadline;
+    if (auto t = transport.nextDeadline()) next = std::min(next, *t);
+    if (auto t = task.wakeAt()) next = std::min(next, *t);
+    bus.wait(std::max(next, now));
+  }
+}
+
+}  // namespace ecsim::master

@@ -1,0 +1,184 @@
+// The master's datagram transport over a Link, advanced only by poll(now): no thread, no
+// blocking, no clock of its own (the time is handed in).
+//
+//  - queue(Datagram&): the datagram waits in a FIFO; poll() packs waiting datagrams, in order,
+//    into frames of at most 1514 bytes (a datagram that cannot fit any frame is refused with
+//    kError, never truncated) and sends them, up to maxFramesInFlight at a time;
+//  - every frame in flight has its own index (all its datagrams carry it); an answer is
+//    matched by that index and checked against what was sent (length, commands, data
+//    lengths) before its data and WKC are copied back into the datagrams;
+//  - a frame unanswered after `timeout` is sent again with the same index (as SOEM and IgH
+//    do), `retries` times; then its datagrams become kTimedOut and the frame counts as lost;
+//  - an answer to a frame already answered or given up counts as late; a frame that matches
+//    nothing of ours (unknown index, other content, not EtherCAT) as unexpected.
+//
+// CachedFrame is the cyclic path: a frame built once by its owner, sent as it is each cycle
+// (only its index bytes are rewritten), answered into the frame's own receive buffer. It is
+// never retried: a cyclic frame still unanswered when the next cycle starts is abandoned and
+// counts as lost. Neither poll() nor send(CachedFrame&) allocates.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "link/link.hpp"
+#include "master/datagram.hpp"
+#include "protocol/ethernet.hpp"
+#include "protocol/frame.hpp"
+#include "protocol/time.hpp"
+
+namespace ecsim::master {
+
+struct TransportOptions {
+  // Per try; SOEM's EC_TIMEOUTRET is 2 ms (notes/soem-interop.md §3.8).
+  SimTime timeout{2 * kNsPerMs};
+  // Resends of an unanswered frame (same index); 2 gives SOEM's 3 tries of EC_TIMEOUTRET3.
+  unsigned retries{2};
+  std::size_t maxFramesInFlight{16};
+  // Source address of our frames: locally administered, unicast.
+  MacAddress source{0x02, 0x00, 0x00, 0x00, 0xEC, 0x01};
+};
+
+struct TransportCounters {
+  std::uint64_t framesSent{0};        // first transmissions (acyclic and cyclic)
+  std::uint64_t framesResent{0};      // retries with the same index
+  std::uint64_t framesReceived{0};    // every frame the link delivered to us
+  std::uint64_t framesAnswered{0};    // matched to a frame in flight
+  std::uint64_t framesLost{0};        // given up after every try, or abandoned (cyclic)
+  std::uint64_t framesLate{0};        // an answer to a frame already answered or given up
+  std::uint64_t framesUnexpected{0};  // not one of ours (index unknown, content differs, ...)
+  std::uint64_t datagramsSent{0};
+  std::uint64_t datagramsTimedOut{0};
+  std::uint64_t datagramsRefused{0};  // too large for any frame
+  std::uint64_t sendErrors{0};
+  std::uint64_t receiveErrors{0};
+};
+
+class Transport;
+
+// A frame built once and sent repeatedly (cyclic process data).
+class CachedFrame {
+ public:
+  CachedFrame() = default;
+  CachedFrame(const CachedFrame&) = delete;
+  CachedFrame& operator=(const CachedFrame&) = delete;
+  ~CachedFrame();
+
+  // The whole transmit buffer, for a FrameBuilder; then commit(length) with what finish()
+  // returned. commit() checks the frame and records where its datagrams lie.
+  Bytes buildBuffer() { return Bytes(tx_.data(), tx_.size()); }
+  Status commit(std::size_t length);
+
+  std::size_t length() const { return length_; }
+  std::size_t datagramCount() const { return datagramOffsets_.size(); }
+  // Offset of datagram k's header within the frame (its data starts 10 bytes later).
+  std::size_t datagramOffset(std::size_t k) const { return datagramOffsets_[k]; }
+  Bytes tx() { return Bytes(tx_.data(), length_); }
+  ConstBytes tx() const { return ConstBytes(tx_.data(), length_); }
+  // The answer (valid when state() == kReceived).
+  ConstBytes rx() const { return ConstBytes(rx_.data(), length_); }
+  std::uint16_t rxWkc(std::size_t k) const;
+  ConstBytes rxData(std::size_t k) const;
+
+  DatagramState state() const { return state_; }
+  bool pending() const { return state_ == DatagramState::kSent; }
+  SimTime sentAt() const { return sentAt_; }
+  SimTime receivedAt() const { return receivedAt_; }
+
+ private:
+  friend class Transport;
+  std::array<std::uint8_t, kMaxFrameSize> tx_{};
+  std::array<std::uint8_t, kMaxFrameSize> rx_{};
+  std::size_t length_{0};
+  std::vector<std::size_t> datagramOffsets_;
+  DatagramState state_{DatagramState::kIdle};
+  SimTime sentAt_{0};
+  SimTime receivedAt_{0};
+  Transport* owner_{nullptr};
+};
+
+class Transport {
+ public:
+  // Most datagrams one frame can hold (empty datagrams of 12 bytes in 1498 bytes).
+  static constexpr std::size_t kMaxDatagramsPerFrame = 128;
+  // Most data one datagram can carry in an untagged frame.
+  static constexpr std::size_t kMaxDatagramData =
+      kMaxFrameSize - kEthernetHeaderSize - kEtherCatHeaderSize - kDatagramOverhead;
+
+  explicit Transport(Link& link, TransportOptions options = {});
+  ~Transport();
+  Transport(const Transport&) = delete;
+  Transport& operator=(const Transport&) = delete;
+
+  // Appends to the send queue (state kQueued). A datagram already queued or in flight is
+  // withdrawn first. The datagram must stay alive until it is answered, timed out or cancelled.
+  void queue(Datagram& datagram);
+  // Withdraws a queued or sent datagram (state back to kIdle); an answer is then ignored.
+  void cancel(Datagram& datagram);
+
+  // Sends a cached frame now under a fresh index. kState if it is still in flight, kTooLarge
+  // when every frame slot is busy.
+  Status send(CachedFrame& frame, SimTime now);
+  // Gives up waiting for a cached frame in flight: it counts as lost (an answer still coming
+  // counts as late).
+  void abandon(CachedFrame& frame);
+
+  // Receives every waiting frame, handles timeouts and retries, sends queued datagrams.
+  void poll(SimTime now);
+
+  // Nothing queued and nothing in flight.
+  bool idle() const { return queueHead_ == nullptr && inFlight_ == 0; }
+  std::size_t framesInFlight() const { return inFlight_; }
+  // Earliest time a frame in flight times out, if any is in flight.
+  std::optional<SimTime> nextDeadline() const;
+
+  const TransportCounters& counters() const { return counters_; }
+  const TransportOptions& options() const { return options_; }
+  Link& link() { return link_; }
+
+ private:
+  friend class CachedFrame;
+  enum class IndexState : std::uint8_t { kUnused, kInFlight, kClosed };
+  struct Slot {
+    bool busy{false};
+    std::uint8_t index{0};
+    std::array<std::uint8_t, kMaxFrameSize> buffer{};
+    std::size_t length{0};
+    SimTime deadline{0};
+    unsigned triesLeft{0};
+    std::array<Datagram*, kMaxDatagramsPerFrame> datagrams{};
+    std::size_t datagramCount{0};
+    CachedFrame* cached{nullptr};
+  };
+
+  void receiveAll(SimTime now);
+  void handleFrame(std::size_t length, SimTime now);
+  bool answerMatches(const Slot& slot, ConstBytes tx, ConstEtherCatFrame& answer) const;
+  void checkTimeouts(SimTime now);
+  void sendQueued(SimTime now);
+  bool packFrame(Slot& slot, SimTime now);
+  std::optional<std::uint8_t> takeIndex();
+  Slot* freeSlot();
+  void release(Slot& slot, DatagramState datagramState);
+  void unlinkQueued(Datagram& datagram);
+  void detachCached(CachedFrame& frame);
+  ConstBytes slotTx(const Slot& slot) const;
+
+  Link& link_;
+  TransportOptions options_;
+  TransportCounters counters_{};
+  EthernetHeader ethernet_{};
+  std::vector<Slot> slots_;
+  std::size_t inFlight_{0};
+  std::array<IndexState, 256> indexState_{};
+  std::array<std::int16_t, 256> indexSlot_{};
+  std::uint8_t nextIndex_{0};
+  Datagram* queueHead_{nullptr};
+  Datagram* queueTail_{nullptr};
+  std::array<std::uint8_t, kMaxFrameSize> rx_{};
+};
+
+}  // namespace ecsim::master
