@@ -14,7 +14,7 @@ set -euo pipefail
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 build=${1:-$repo/build/fuzz}
 runs=${2:-100000}
-targets=(fuzz_frame fuzz_mailbox)
+targets=(fuzz_frame fuzz_mailbox fuzz_esc)
 
 case $build in /*) ;; *) build=$PWD/$build ;; esac
 if ! [[ $runs =~ ^[0-9]+$ ]]; then
