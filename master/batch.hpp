@@ -1,0 +1,59 @@
+// A group of datagrams sent together (the transport packs them into as few frames as fit) and
+// checked together: the register writes of one configuration step, the AL status reads of all
+// slaves. Datagrams live in a deque so their addresses stay fixed while queued.
+#pragma once
+
+#include <cstddef>
+#include <deque>
+#include <string>
+
+#include "master/datagram.hpp"
+#include "master/transport.hpp"
+#include "protocol/result.hpp"
+
+namespace ecsim::master {
+
+class DatagramBatch {
+ public:
+  Datagram& add() { return datagrams_.emplace_back(); }
+  void clear() { datagrams_.clear(); }
+  std::size_t size() const { return datagrams_.size(); }
+  bool empty() const { return datagrams_.empty(); }
+  Datagram& operator[](std::size_t i) { return datagrams_[i]; }
+  const Datagram& operator[](std::size_t i) const { return datagrams_[i]; }
+
+  void queueAll(Transport& transport) {
+    for (auto& d : datagrams_) transport.queue(d);
+  }
+  bool pending() const {
+    for (const auto& d : datagrams_) {
+      if (d.pending()) return true;
+    }
+    return false;
+  }
+  // Ok when every datagram came back with its expected WKC; otherwise the first failure's
+  // code and every failure's context (up to a handful), joined by "; ".
+  Status check() const {
+    std::string context;
+    std::size_t failures = 0;
+    ErrorCode code = ErrorCode::kWorkingCounter;
+    for (const auto& d : datagrams_) {
+      auto s = d.check();
+      if (s.ok()) continue;
+      if (failures == 0) code = s.error().code;
+      if (failures < kMaxListed) context += (failures == 0 ? "" : "; ") + s.error().context;
+      ++failures;
+    }
+    if (failures == 0) return okStatus();
+    if (failures > kMaxListed) {
+      context += "; and " + std::to_string(failures - kMaxListed) + " more";
+    }
+    return makeError(code, context);
+  }
+
+ private:
+  static constexpr std::size_t kMaxListed = 4;
+  std::deque<Datagram> datagrams_;
+};
+
+}  // namespace ecsim::master

@@ -1,0 +1,305 @@
+#include "master/scan.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+
+#include "protocol/registers.hpp"
+
+namespace ecsim::master {
+namespace {
+
+// Register reads of the scan, in the order queued per slave.
+constexpr std::uint16_t kEscInfoLength =
+    static_cast<std::uint16_t>(reg::kEscFeatures.end() - reg::kType.address);
+constexpr std::uint16_t kAlStatusLength =
+    static_cast<std::uint16_t>(reg::kAlStatusCode.end() - reg::kAlStatus.address);
+constexpr std::size_t kReadsPerSlave = 5;
+
+// SII General category defaults for the mailbox control bytes (SOEM's values, §3.2).
+constexpr std::uint8_t kMailboxOutControl = 0x26;
+constexpr std::uint8_t kMailboxInControl = 0x22;
+
+// DL status: port n is in use when its loop is open and it has communication.
+bool portActive(std::uint16_t dlStatus, unsigned port) {
+  return (dlStatus & reg::dl_status::loopPort(port)) == 0 &&
+         (dlStatus & reg::dl_status::communication(port)) != 0;
+}
+
+}  // namespace
+
+void computeTopology(std::vector<SlaveInfo>& slaves) {
+  struct Open {
+    std::size_t position;
+    int remaining;  // active ports not yet followed
+  };
+  std::vector<Open> stack;
+  for (auto& slave : slaves) {
+    slave.activePorts = 0;
+    for (unsigned p = 0; p < 4; ++p) {
+      if (portActive(slave.dlStatus, p)) slave.activePorts |= static_cast<std::uint8_t>(1u << p);
+    }
+    int active = 0;
+    for (unsigned p = 0; p < 4; ++p) active += (slave.activePorts >> p) & 1;
+    while (!stack.empty() && stack.back().remaining <= 0) stack.pop_back();
+    if (stack.empty()) {
+      slave.parent = -1;
+    } else {
+      slave.parent = static_cast<int>(stack.back().position);
+      --stack.back().remaining;
+    }
+    // The port towards the parent (or master) is one of the active ones.
+    stack.push_back({slave.position, std::max(0, active - 1)});
+  }
+}
+
+void applySii(SlaveInfo& slave) {
+  auto image = SiiImage::parseLenient(slave.sii);
+  if (!image.ok()) {
+    slave.siiDamage = image.error();
+    slave.siiContents = {};
+  } else {
+    slave.siiContents = image->contents();
+    slave.siiDamage = image->damage();
+  }
+  const SiiContents& c = slave.siiContents;
+  std::string_view name;
+  if (c.general && c.general->nameIndex != 0) name = c.string(c.general->nameIndex);
+  if (name.empty()) name = c.string(1);  // SOEM's choice: string 1
+  if (name.empty()) {
+    char buf[48];
+    std::snprintf(buf, sizeof buf, "? M:%08X I:%08X", c.identity.vendorId, c.identity.productCode);
+    slave.name = buf;
+  } else {
+    slave.name = std::string(name);
+  }
+  slave.mailbox.reset();
+  const SiiMailbox& m = c.standardMailbox;
+  if (m.receiveSize > 0) {
+    MailboxConfig mbx;
+    mbx.outStart = m.receiveOffset;
+    mbx.outSize = m.receiveSize;
+    mbx.inStart = m.sendOffset;
+    mbx.inSize = m.sendSize != 0 ? m.sendSize : m.receiveSize;
+    mbx.outControl = kMailboxOutControl;
+    mbx.inControl = kMailboxInControl;
+    // The SM category has the control bytes the device wants (SOEM programs SM0/SM1 from it).
+    for (const auto& sm : c.syncManagers) {
+      if (sm.type == SiiSyncManagerType::kMailboxOut && sm.control != 0) {
+        mbx.outControl = sm.control;
+      }
+      if (sm.type == SiiSyncManagerType::kMailboxIn && sm.control != 0) {
+        mbx.inControl = sm.control;
+      }
+    }
+    mbx.protocols = c.mailboxProtocols;
+    slave.mailbox = mbx;
+  }
+}
+
+ScanTask::ScanTask(Transport& transport, std::vector<SlaveInfo>& slaves, ScanOptions options)
+    : transport_(transport), slaves_(slaves), options_(options) {}
+
+void ScanTask::start(SimTime /*now*/) {
+  slaves_.clear();
+  readers_.clear();
+  batch_.clear();
+  status_ = okStatus();
+  count_.prepare(Command::kBrd, DatagramHeader::physical(0, reg::kType.address), 2, 0);
+  transport_.queue(count_);
+  state_ = State::kCount;
+}
+
+bool ScanTask::fail(Status status) {
+  status_ = std::move(status);
+  state_ = State::kFailed;
+  return false;
+}
+
+std::optional<SimTime> ScanTask::wakeAt() const {
+  std::optional<SimTime> earliest;
+  for (const auto& r : readers_) {
+    auto t = r.wakeAt();
+    if (t && (!earliest || *t < *earliest)) earliest = t;
+  }
+  return earliest;
+}
+
+void ScanTask::queueDefaults() {
+  batch_.clear();
+  const auto n = static_cast<std::uint16_t>(slaves_.size());
+  auto bwr = [&](std::uint16_t address, std::initializer_list<std::uint8_t> bytes,
+                 std::uint16_t expected) {
+    std::vector<std::uint8_t> data(bytes);
+    batch_.add().prepare(Command::kBwr, DatagramHeader::physical(0, address), data, expected);
+  };
+  auto bwrZero = [&](std::uint16_t address, std::uint16_t length) {
+    batch_.add().prepare(Command::kBwr, DatagramHeader::physical(0, address), length, 0);
+  };
+  // INIT with error acknowledge first; its WKC is checked (every slave must take it).
+  bwr(reg::kAlControl.address,
+      {static_cast<std::uint8_t>(kAlErrorFlag | static_cast<std::uint16_t>(AlState::kInit)), 0}, n);
+  // The other writes are best effort: an ESC without DC, say, need not count them.
+  bwr(static_cast<std::uint16_t>(reg::kDlControl.address + 1), {0}, 0);  // loop control: auto
+  bwr(static_cast<std::uint16_t>(reg::kDlControl.address + 3), {0}, 0);  // station alias off
+  bwr(reg::kEcatEventMask.address, {0x04, 0x00}, 0);                     // AL status event
+  bwrZero(reg::rxErrorCounters(0), 8);
+  bwrZero(reg::fmmuChannel(0), 3 * reg::kFmmuSize);
+  bwrZero(reg::smChannel(0), 4 * reg::kSmSize);
+  bwr(reg::kDcActivation.address, {0}, 0);
+  bwrZero(reg::kSystemTime.address, 4);
+  bwr(reg::kSpeedCounterStart.address, {0x00, 0x10}, 0);                // 0x1000
+  bwr(reg::kSystemTimeDifferenceFilterDepth.address, {0x00, 0x0C}, 0);  // and speed filter 12
+  bwr(reg::kSiiConfiguration.address, {0x02}, 0);  // force the EEPROM to the ECAT side...
+  bwr(reg::kSiiConfiguration.address, {0x00}, 0);  // ...and leave it there
+  batch_.queueAll(transport_);
+}
+
+void ScanTask::queueAddresses() {
+  batch_.clear();
+  for (auto& slave : slaves_) {
+    std::array<std::uint8_t, 2> address{};
+    writeLe16(address, 0, slave.station);
+    batch_.add().prepare(Command::kApwr,
+                         DatagramHeader::physical(Datagram::autoIncrement(slave.position),
+                                                  reg::kConfiguredStationAddress.address),
+                         address, 1);
+  }
+  batch_.queueAll(transport_);
+}
+
+void ScanTask::queueRegisters() {
+  batch_.clear();
+  for (auto& slave : slaves_) {
+    batch_.add().fprd(slave.station, reg::kType.address, kEscInfoLength);
+    batch_.add().fprd(slave.station, reg::kConfiguredStationAlias.address, 2);
+    batch_.add().fprd(slave.station, reg::kDlStatus.address, 2);
+    batch_.add().fprd(slave.station, reg::kAlStatus.address, kAlStatusLength);
+    batch_.add().fprd(slave.station, reg::kSiiControlStatus.address, 2);
+  }
+  batch_.queueAll(transport_);
+}
+
+void ScanTask::takeRegisters() {
+  for (auto& slave : slaves_) {
+    const std::size_t base = slave.position * kReadsPerSlave;
+    ConstBytes info = batch_[base].data();
+    slave.escType = info[reg::kType.address];
+    slave.escRevision = info[reg::kRevision.address];
+    slave.escBuild = readLe16(info, reg::kBuild.address);
+    slave.fmmuCount = info[reg::kFmmusSupported.address];
+    slave.syncManagerCount = info[reg::kSyncManagersSupported.address];
+    slave.ramKb = info[reg::kRamSize.address];
+    slave.portDescriptor = info[reg::kPortDescriptor.address];
+    slave.features = readLe16(info, reg::kEscFeatures.address);
+    slave.alias = readLe16(batch_[base + 1].data(), 0);
+    slave.dlStatus = readLe16(batch_[base + 2].data(), 0);
+    ConstBytes al = batch_[base + 3].data();
+    slave.alStatus = readLe16(al, 0);
+    slave.alStatusCode = readLe16(al, reg::kAlStatusCode.address - reg::kAlStatus.address);
+    slave.siiReads8Bytes = (readLe16(batch_[base + 4].data(), 0) & reg::sii::kReadSize8Bytes) != 0;
+  }
+  computeTopology(slaves_);
+}
+
+void ScanTask::startSii(SimTime now) {
+  readers_.clear();
+  for (auto& slave : slaves_) {
+    auto& reader =
+        readers_.emplace_back(transport_, slave.station, slave.siiReads8Bytes, options_.sii);
+    reader.start(now);
+  }
+}
+
+void ScanTask::finishSii() {
+  for (auto& slave : slaves_) {
+    slave.sii = readers_[slave.position].takeImage();
+    applySii(slave);
+  }
+  readers_.clear();
+}
+
+bool ScanTask::step(SimTime now) {
+  switch (state_) {
+    case State::kIdle:
+    case State::kDone:
+    case State::kFailed:
+      return false;
+    case State::kCount: {
+      if (count_.pending()) return true;
+      if (!count_.received()) {
+        return fail(makeError(ErrorCode::kTimeout,
+                              "no slaves found: no answer to the slave count (nothing connected "
+                              "or the link is down): " +
+                                  count_.check().error().context));
+      }
+      slaves_.resize(count_.wkc());
+      for (std::size_t i = 0; i < slaves_.size(); ++i) {
+        slaves_[i].position = i;
+        slaves_[i].station = static_cast<std::uint16_t>(options_.firstStation + i);
+      }
+      if (slaves_.empty()) {
+        state_ = State::kDone;
+        return false;
+      }
+      if (options_.resetToDefaults) {
+        queueDefaults();
+        state_ = State::kDefaults;
+      } else {
+        queueAddresses();
+        state_ = State::kAddresses;
+      }
+      return true;
+    }
+    case State::kDefaults: {
+      if (batch_.pending()) return true;
+      if (auto s = batch_[0].check(); !s.ok()) {
+        return fail(makeError(s.error().code, "reset to INIT: " + s.error().context));
+      }
+      queueAddresses();
+      state_ = State::kAddresses;
+      return true;
+    }
+    case State::kAddresses: {
+      if (batch_.pending()) return true;
+      if (auto s = batch_.check(); !s.ok()) {
+        return fail(makeError(s.error().code, "station addresses: " + s.error().context));
+      }
+      queueRegisters();
+      state_ = State::kRegisters;
+      return true;
+    }
+    case State::kRegisters: {
+      if (batch_.pending()) return true;
+      if (auto s = batch_.check(); !s.ok()) {
+        return fail(makeError(s.error().code, "slave registers: " + s.error().context));
+      }
+      takeRegisters();
+      batch_.clear();
+      if (!options_.readSii) {
+        state_ = State::kDone;
+        return false;
+      }
+      startSii(now);
+      state_ = State::kSii;
+      [[fallthrough]];
+    }
+    case State::kSii: {
+      bool running = false;
+      for (auto& reader : readers_) running = reader.step(now) || running;
+      if (running) return true;
+      for (std::size_t i = 0; i < readers_.size(); ++i) {
+        if (!readers_[i].status().ok()) {
+          return fail(makeError(readers_[i].status().error().code,
+                                slaves_[i].label() + ": " + readers_[i].status().error().context));
+        }
+      }
+      finishSii();
+      state_ = State::kDone;
+      return false;
+    }
+  }
+  return false;
+}
+
+}  // namespace ecsim::master

@@ -1,0 +1,73 @@
+// The bus scan as a non-blocking state machine (the sequence of notes/soem-interop.md §3.3,
+// stepped IgH-style):
+//
+//   count       BRD 0x0000; the WKC is the number of slaves
+//   defaults    BWR: AL control INIT + acknowledge, DL control loop bytes, event mask, error
+//               counters, FMMU0-2 and SM0-3 cleared, DC activation / system time / filters
+//               reset, EEPROM handed to the EtherCAT side (0x0500 = 2 then 0)
+//   addresses   APWR 0x0010 = firstStation + position, one per slave
+//   registers   FPRD per slave: ESC information 0x0000-0x0009, alias 0x0012, DL status
+//               0x0110, AL status and code 0x0130-0x0135, EEPROM control 0x0502
+//   SII         every slave's EEPROM at once (one SiiReader each; their datagrams share
+//               frames), then parsed: identity, name, mailbox, categories
+//
+// The topology (each slave's parent) follows from the DL status of every slave in processing
+// order: a port counts when its loop is open and it has communication.
+#pragma once
+
+#include <deque>
+#include <optional>
+#include <vector>
+
+#include "master/batch.hpp"
+#include "master/bus.hpp"
+#include "master/sii_reader.hpp"
+#include "master/slave_info.hpp"
+#include "master/transport.hpp"
+
+namespace ecsim::master {
+
+struct ScanOptions {
+  std::uint16_t firstStation{0x1001};
+  bool resetToDefaults{true};
+  bool readSii{true};
+  SiiReaderOptions sii;
+};
+
+class ScanTask final : public Task {
+ public:
+  ScanTask(Transport& transport, std::vector<SlaveInfo>& slaves, ScanOptions options = {});
+
+  void start(SimTime now);
+  bool step(SimTime now) override;
+  std::optional<SimTime> wakeAt() const override;
+  const Status& status() const { return status_; }
+
+ private:
+  enum class State { kIdle, kCount, kDefaults, kAddresses, kRegisters, kSii, kDone, kFailed };
+
+  void queueDefaults();
+  void queueAddresses();
+  void queueRegisters();
+  void takeRegisters();
+  void startSii(SimTime now);
+  void finishSii();
+  bool fail(Status status);
+
+  Transport& transport_;
+  std::vector<SlaveInfo>& slaves_;
+  ScanOptions options_;
+  State state_{State::kIdle};
+  Status status_;
+  Datagram count_;
+  DatagramBatch batch_;
+  std::deque<SiiReader> readers_;
+};
+
+// Each slave's active ports from its DL status, and its parent from the active ports of all
+// slaves in processing order (ports are visited 0 -> 3 -> 1 -> 2, depth first).
+void computeTopology(std::vector<SlaveInfo>& slaves);
+// Fills name, mailbox and contents from slave.sii (lenient parse; damage is kept).
+void applySii(SlaveInfo& slave);
+
+}  // namespace ecsim::master

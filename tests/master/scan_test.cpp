@@ -1,0 +1,169 @@
+// The scan against simulated slaves: slave count, station addresses, ESC registers, SII read
+// through the EEPROM interface (4- and 8-byte reads) and parsed, names, topology.
+#include "master/scan.hpp"
+
+#include <gtest/gtest.h>
+
+#include "tests/master/sim_network.hpp"
+#include "tests/master/test_slaves.hpp"
+
+namespace ecsim::testing {
+namespace {
+
+using master::ScanTask;
+using master::SlaveInfo;
+using master::Transport;
+
+struct Scanned {
+  Status status;
+  std::vector<SlaveInfo> slaves;
+};
+
+Scanned scan(SimNetwork& net, master::ScanOptions options = {}) {
+  Transport transport(net.masterLink());
+  Scanned out;
+  ScanTask task(transport, out.slaves, options);
+  task.start(net.clock().now());
+  auto run = master::runTask(task, transport, net.bus(), 10 * kNsPerSecond, "scan");
+  out.status = run.ok() ? task.status() : run;
+  return out;
+}
+
+TEST(ScanTest, FindsGenericSlavesWithIdentityNamesAndAddresses) {
+  SimNetwork net;
+  for (std::uint32_t i = 0; i < 4; ++i) {
+    net.segment().addSlave(slavesim::makeGenericSlave("Slave" + std::to_string(i + 1), 100 + i));
+  }
+  net.segment().wireLine();
+  net.start();
+  auto result = scan(net);
+  ASSERT_TRUE(result.status.ok()) << result.status.error().message();
+  ASSERT_EQ(result.slaves.size(), 4u);
+  for (std::size_t i = 0; i < 4; ++i) {
+    const SlaveInfo& s = result.slaves[i];
+    EXPECT_EQ(s.position, i);
+    EXPECT_EQ(s.station, 0x1001 + i);
+    // The simulated ESC now answers to that address.
+    EXPECT_EQ(net.segment().slave(i).esc().reg16(reg::kConfiguredStationAddress.address),
+              0x1001 + i);
+    EXPECT_EQ(s.name, "Slave" + std::to_string(i + 1));
+    EXPECT_EQ(s.identity().vendorId, slavesim::kEcsimVendorId);
+    EXPECT_EQ(s.identity().productCode, slavesim::kGenericProductCode);
+    EXPECT_EQ(s.identity().serial, 100 + i);
+    EXPECT_EQ(s.escType, slavesim::kEt1100.typeRegister);
+    EXPECT_EQ(s.fmmuCount, 8);
+    EXPECT_EQ(s.syncManagerCount, 8);
+    EXPECT_TRUE(s.hasDc());
+    EXPECT_EQ(s.state(), AlState::kInit);
+    EXPECT_FALSE(s.mailbox.has_value());
+    EXPECT_FALSE(s.siiDamage.has_value());
+    // Line: each slave's parent is the one before it.
+    EXPECT_EQ(s.parent, static_cast<int>(i) - 1);
+    EXPECT_EQ(s.activePorts, i + 1 < 4 ? 0x03 : 0x01);
+    // The SII bytes read are the slave's EEPROM up to the END category.
+    const auto& eeprom = net.segment().slave(i).esc().sii();
+    ASSERT_LE(s.sii.size(), eeprom.size());
+    EXPECT_TRUE(std::equal(s.sii.begin(), s.sii.end(), eeprom.begin()));
+  }
+}
+
+TEST(ScanTest, NothingConnectedSaysNoSlavesFound) {
+  SimNetwork net;
+  net.start();  // an empty segment answers nothing, as an unplugged port
+  auto result = scan(net);
+  ASSERT_FALSE(result.status.ok());
+  EXPECT_EQ(result.status.error().code, ErrorCode::kTimeout);
+  EXPECT_NE(result.status.error().context.find("no slaves found"), std::string::npos)
+      << result.status.error().context;
+  EXPECT_TRUE(result.slaves.empty());
+}
+
+TEST(ScanTest, SiiCategoriesParsedWithFourAndEightByteReads) {
+  SimNetwork net;
+  const SiiContents io = ioSii("IO4", 0x2004, 4, 2, 77);
+  net.segment().addSlave(makeSiiSlave("IO4", io, {}, slavesim::kEt1100));    // 4-byte reads
+  net.segment().addSlave(makeSiiSlave("IO4b", io, {}, slavesim::kLan9252));  // 8-byte reads
+  net.segment().wireLine();
+  net.start();
+  auto result = scan(net);
+  ASSERT_TRUE(result.status.ok()) << result.status.error().message();
+  ASSERT_EQ(result.slaves.size(), 2u);
+  EXPECT_FALSE(result.slaves[0].siiReads8Bytes);
+  EXPECT_TRUE(result.slaves[1].siiReads8Bytes);
+  for (const auto& s : result.slaves) {
+    EXPECT_EQ(s.name, "IO4");
+    const SiiContents& c = s.siiContents;
+    EXPECT_EQ(c.identity, io.identity);
+    EXPECT_EQ(c.strings, io.strings);
+    EXPECT_EQ(c.general, io.general);
+    EXPECT_EQ(c.fmmus, io.fmmus);
+    EXPECT_EQ(c.syncManagers, io.syncManagers);
+    EXPECT_EQ(c.rxPdos, io.rxPdos);
+    EXPECT_EQ(c.txPdos, io.txPdos);
+  }
+}
+
+TEST(ScanTest, MailboxFromSiiHeaderAndSmCategory) {
+  SimNetwork net;
+  SiiContents c = ioSii("Mbx", 0x3000, 0, 1);
+  c.standardMailbox = {0x1800, 128, 0x1880, 64};
+  c.mailboxProtocols = SiiMailboxProtocol::kCoe | SiiMailboxProtocol::kFoe;
+  c.syncManagers.insert(c.syncManagers.begin(),
+                        {{0x1800, 128, 0x26, 0, 1, SiiSyncManagerType::kMailboxOut},
+                         {0x1880, 64, 0x22, 0, 1, SiiSyncManagerType::kMailboxIn}});
+  net.segment().addSlave(makeSiiSlave("Mbx", c));
+  net.segment().wireLine();
+  net.start();
+  auto result = scan(net);
+  ASSERT_TRUE(result.status.ok()) << result.status.error().message();
+  const auto& s = result.slaves.at(0);
+  ASSERT_TRUE(s.mailbox.has_value());
+  EXPECT_EQ(s.mailbox->outStart, 0x1800);
+  EXPECT_EQ(s.mailbox->outSize, 128);
+  EXPECT_EQ(s.mailbox->inStart, 0x1880);
+  EXPECT_EQ(s.mailbox->inSize, 64);
+  EXPECT_EQ(s.mailbox->outControl, 0x26);
+  EXPECT_EQ(s.mailbox->inControl, 0x22);
+  EXPECT_TRUE(s.hasCoe());
+}
+
+TEST(ScanTest, TreeTopologyFromDlStatus) {
+  // A junction with a branch on port 3 (visited first) and the line continuing on port 1.
+  SimNetwork net;
+  for (int i = 0; i < 4; ++i) {
+    net.segment().addSlave(slavesim::makeGenericSlave("S" + std::to_string(i), 0));
+  }
+  ASSERT_TRUE(net.segment().connect(0, 3, 1, 0).ok());
+  ASSERT_TRUE(net.segment().connect(0, 1, 2, 0).ok());
+  ASSERT_TRUE(net.segment().connect(2, 1, 3, 0).ok());
+  net.segment().refreshLinkStatus();
+  net.start();
+  auto result = scan(net);
+  ASSERT_TRUE(result.status.ok()) << result.status.error().message();
+  ASSERT_EQ(result.slaves.size(), 4u);
+  EXPECT_EQ(result.slaves[0].activePorts, 0x0B);  // ports 0, 1, 3
+  EXPECT_EQ(result.slaves[0].parent, -1);
+  EXPECT_EQ(result.slaves[1].parent, 0);
+  EXPECT_EQ(result.slaves[2].parent, 0);
+  EXPECT_EQ(result.slaves[3].parent, 2);
+  EXPECT_EQ(result.slaves[1].name, "S1");
+}
+
+TEST(ScanTest, SiiReadErrorsNameTheSlave) {
+  SimNetwork net;
+  net.segment().addSlave(slavesim::makeGenericSlave("A", 1));
+  net.segment().wireLine();
+  net.start();
+  // Every frame after the register reads is lost: the SII read times out and says where.
+  net.fault().dropSend = {5, 6, 7};
+  auto result = scan(net);
+  ASSERT_FALSE(result.status.ok());
+  EXPECT_EQ(result.status.error().code, ErrorCode::kTimeout);
+  EXPECT_NE(result.status.error().context.find("slave 0 (0x1001)"), std::string::npos)
+      << result.status.error().context;
+  EXPECT_NE(result.status.error().context.find("SII read of word 0x0000"), std::string::npos)
+      << result.status.error().context;
+}
+
+}  // namespace
+}  // namespace ecsim::testing

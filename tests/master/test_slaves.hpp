@@ -1,0 +1,88 @@
+// Simulated slaves for the master tests, built with protocol/sii.hpp's encodeSii so that every
+// SII field the master reads is known to the test:
+//   - ioSii(): a digital/analog I/O terminal without mailbox whose process data is described
+//     only by the SII (SM category: SM0 outputs 3-buffer 0x1000, SM1 inputs 3-buffer 0x1100;
+//     FMMU category; RxPDO 0x1600 with one entry per output byte, TxPDO 0x1A00 with 16-bit
+//     entries) - what an EL2004/EL1004 class device looks like to a master;
+//   - makeIoSlave(): such a slave whose firmware expects exactly those SM lengths at
+//     PREOP->SAFEOP (a master that maps wrongly gets AL status 0x001D/0x001E).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "protocol/sii.hpp"
+#include "slavesim/esc_type.hpp"
+#include "slavesim/generic_slave.hpp"
+#include "slavesim/slave.hpp"
+
+namespace ecsim::testing {
+
+inline constexpr std::uint32_t kTestVendor = 0x00000E5C;
+inline constexpr std::uint16_t kIoOutputSm = 0x1000;
+inline constexpr std::uint16_t kIoInputSm = 0x1100;
+
+// outputs: `outBytes` 8-bit entries 0x7000:1..n; inputs: `inWords` 16-bit entries 0x6000:1..n.
+inline SiiContents ioSii(const std::string& name, std::uint32_t product, std::uint16_t outBytes,
+                         std::uint16_t inWords, std::uint32_t serial = 0) {
+  SiiContents c;
+  c.config.pdiControl = 0x0004;  // digital I/O PDI
+  c.identity = {kTestVendor, product, 0x00020000, serial};
+  c.sizeField = siiSizeFieldForBytes(2048);
+  c.strings = {name, "Outputs", "Inputs", "Out", "In"};
+  SiiGeneral g;
+  g.nameIndex = 1;
+  g.physicalPorts = 0x0011;
+  c.general = g;
+  c.fmmus = {SiiFmmuUsage::kOutputs, SiiFmmuUsage::kInputs};
+  SiiSyncManager out{
+      kIoOutputSm, outBytes, 0x64, 0, SiiSyncManagerEnable::kEnable, SiiSyncManagerType::kOutputs};
+  SiiSyncManager in{
+      kIoInputSm, static_cast<std::uint16_t>(2 * inWords), 0x20,
+      0,          SiiSyncManagerEnable::kEnable,           SiiSyncManagerType::kInputs};
+  c.syncManagers = {out, in};
+  if (outBytes > 0) {
+    SiiPdo rx;
+    rx.index = 0x1600;
+    rx.syncManager = 0;
+    rx.nameIndex = 2;
+    for (std::uint16_t i = 0; i < outBytes; ++i) {
+      rx.entries.push_back({0x7000, static_cast<std::uint8_t>(i + 1), 4, 0x05, 8, 0});
+    }
+    c.rxPdos.push_back(rx);
+  }
+  if (inWords > 0) {
+    SiiPdo tx;
+    tx.index = 0x1A00;
+    tx.syncManager = 1;
+    tx.nameIndex = 3;
+    for (std::uint16_t i = 0; i < inWords; ++i) {
+      tx.entries.push_back({0x6000, static_cast<std::uint8_t>(i + 1), 5, 0x06, 16, 0});
+    }
+    c.txPdos.push_back(tx);
+  }
+  return c;
+}
+
+inline std::unique_ptr<slavesim::Slave> makeSiiSlave(
+    const std::string& name, const SiiContents& contents, slavesim::SlaveProfile profile = {},
+    const slavesim::EscType& esc = slavesim::kEt1100) {
+  auto image = encodeSii(contents);
+  EXPECT_TRUE(image.ok()) << (image.ok() ? "" : image.error().message());
+  return std::make_unique<slavesim::Slave>(
+      name, esc, image.ok() ? *image : std::vector<std::uint8_t>{}, std::move(profile));
+}
+
+inline std::unique_ptr<slavesim::Slave> makeIoSlave(
+    const std::string& name, std::uint32_t product, std::uint16_t outBytes, std::uint16_t inWords,
+    const slavesim::EscType& esc = slavesim::kEt1100) {
+  slavesim::SlaveProfile profile;
+  if (outBytes > 0) profile.processData.push_back({0, true, outBytes});
+  if (inWords > 0) {
+    profile.processData.push_back({1, false, static_cast<std::uint16_t>(2 * inWords)});
+  }
+  return makeSiiSlave(name, ioSii(name, product, outBytes, inWords), std::move(profile), esc);
+}
+
+}  // namespace ecsim::testing
