@@ -111,6 +111,41 @@ TEST(SoemV2, SlaveinfoListsEverySlaveWithItsIdentity) {
   EXPECT_EQ(out.find("Not all slaves"), std::string::npos) << out;
 }
 
+// ---- distributed clocks: SOEM's propagation-delay measurement against the model -------------
+
+std::vector<long> reportedDelays(const std::string& out) {
+  std::vector<long> delays;
+  std::regex re(" Delay: (-?[0-9]+)\\[ns\\]");
+  for (auto it = std::sregex_iterator(out.begin(), out.end(), re); it != std::sregex_iterator();
+       ++it) {
+    delays.push_back(std::stol((*it)[1]));
+  }
+  return delays;
+}
+
+TEST(SoemDc, PropagationDelaysInALineEqualTheModel) {
+  ECSIM_REQUIRE_SOEM();
+  SoemRun run({"--slaves", "5"});
+  std::string out = run.run("bin-v1/slaveinfo", {}, std::chrono::seconds(60));
+  // Each hop: the ESC's 1000 ns plus 1 m of cable (5 ns), as docs/timing.md gives.
+  EXPECT_EQ(reportedDelays(out), (std::vector<long>{0, 1005, 2010, 3015, 4020})) << out;
+}
+
+TEST(SoemDc, PropagationDelaysInATreeEqualTheModel) {
+  ECSIM_REQUIRE_SOEM();
+  SoemRun run({std::string(ECSIM_SOURCE_DIR) + "/tests/interop/dc_tree.xml"});
+  std::string out = run.run("bin-v1/slaveinfo", {}, std::chrono::seconds(60));
+  // Model arrival times of one frame relative to the junction: A1 = 1000 + 25; A2 = A1 +
+  // 1000 + 10; B1 only after branch A has returned: A2 turns round (1000), back over 10 m of
+  // cable... = 3035 + 10 + 1000 + 25 (A1 and its cable) + 1000 (junction) + 100 (20 m).
+  const std::vector<long> model{0, 1025, 2035, 5170};
+  auto got = reportedDelays(out);
+  ASSERT_EQ(got.size(), model.size()) << out;
+  for (std::size_t i = 0; i < model.size(); ++i) {
+    EXPECT_LE(std::abs(got[i] - model[i]), 10) << "slave " << i + 1 << "\n" << out;
+  }
+}
+
 // ---- the demo network (coupler, DI, DO, AI with CoE, two CiA 402 drives with CoE) ----------
 
 constexpr int kDemoSlaves = 6;
