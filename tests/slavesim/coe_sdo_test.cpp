@@ -275,7 +275,7 @@ TEST(CoeSdo, EmergencyWaitsForAFreeSm1) {
   // transact() skips emergencies as SOEM does and still gets the SDO response.
   t.server->pushEmergency(Emergency{0x1000, 0x01, {}});
   EXPECT_EQ(t.master->uploadValue<std::uint32_t>(0x1000, 0), 0x00001389u);
-  EXPECT_EQ(t.master->emergencies_.size(), 1u);
+  EXPECT_EQ(t.master->emergencies.size(), 1u);
 }
 
 TEST(CoeSdo, NoAnswerWhileTheMailboxIsOff) {

@@ -133,14 +133,14 @@ class MailboxMaster {
       auto r = receive();
       if (!r) return r;
       if (!isEmergency(*r)) return r;
-      emergencies_.push_back(*r);
+      emergencies.push_back(*r);
     }
     return std::nullopt;
   }
   static bool isEmergency(const std::vector<std::uint8_t>& m) {
     return m.size() >= 8 && (m[5] & 0x0F) == 3 && (m[7] >> 4) == 1;
   }
-  std::vector<std::vector<std::uint8_t>> emergencies_;
+  std::vector<std::vector<std::uint8_t>> emergencies;
 
   std::vector<std::uint8_t> sdoRequest(const SdoRequest& request) {
     std::vector<std::uint8_t> m(outSize_, 0);
