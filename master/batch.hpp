@@ -7,6 +7,7 @@
 #include <deque>
 #include <string>
 
+#include "master/bus.hpp"
 #include "master/datagram.hpp"
 #include "master/transport.hpp"
 #include "protocol/result.hpp"
@@ -54,6 +55,16 @@ class DatagramBatch {
  private:
   static constexpr std::size_t kMaxListed = 4;
   std::deque<Datagram> datagrams_;
+};
+
+// A task that runs until every datagram of a batch is answered or given up.
+class BatchWait final : public Task {
+ public:
+  explicit BatchWait(const DatagramBatch& batch) : batch_(batch) {}
+  bool step(SimTime /*now*/) override { return batch_.pending(); }
+
+ private:
+  const DatagramBatch& batch_;
 };
 
 }  // namespace ecsim::master

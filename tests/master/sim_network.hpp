@@ -42,7 +42,9 @@ class FaultLink final : public Link {
       auto r = inner_.receive(buffer, timeout);
       if (!r.ok() || *r == 0) return r;
       ++received_;
-      if (dropReceive.count(received_) == 0) return r;
+      const bool drop = dropReceive.count(received_) != 0 ||
+                        (dropReceiveIf && dropReceiveIf(ConstBytes(buffer.data(), *r)));
+      if (!drop) return r;
       ++droppedReceives;
     }
   }
@@ -54,6 +56,8 @@ class FaultLink final : public Link {
 
   std::set<std::uint64_t> dropSend;
   std::set<std::uint64_t> dropReceive;
+  // Drops a received frame when it returns true (e.g. the first answer to a mailbox read).
+  std::function<bool(ConstBytes)> dropReceiveIf;
   bool dropAllSends{false};
   std::uint64_t droppedSends{0};
   std::uint64_t droppedReceives{0};

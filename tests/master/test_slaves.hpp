@@ -13,6 +13,8 @@
 #include <string>
 
 #include "protocol/sii.hpp"
+#include "slavesim/coe/coe_server.hpp"
+#include "slavesim/coe/object_dictionary.hpp"
 #include "slavesim/esc_type.hpp"
 #include "slavesim/generic_slave.hpp"
 #include "slavesim/slave.hpp"
@@ -83,6 +85,34 @@ inline std::unique_ptr<slavesim::Slave> makeIoSlave(
     profile.processData.push_back({1, false, static_cast<std::uint16_t>(2 * inWords)});
   }
   return makeSiiSlave(name, ioSii(name, product, outBytes, inWords), std::move(profile), esc);
+}
+
+// A CoE slave of our own: standard mailbox 0x1000/128 (out) and 0x1080/128 (in), process-data
+// SMs 0x1100 (outputs, SM2) and 0x1180 (inputs, SM3) of length 0 in the SII, no SII PDOs: the
+// master must take the mapping from the dictionary (0x1C00, 0x1C12/0x1C13, 0x16xx/0x1Axx).
+inline SiiContents coeSii(const std::string& name, std::uint32_t product) {
+  SiiContents c = ioSii(name, product, 0, 0);
+  c.standardMailbox = {0x1000, 128, 0x1080, 128};
+  c.mailboxProtocols = SiiMailboxProtocol::kCoe;
+  c.general->coeDetails = static_cast<std::uint8_t>(SiiCoeDetails::kSdo | SiiCoeDetails::kSdoInfo |
+                                                    SiiCoeDetails::kSdoCompleteAccess);
+  c.syncManagers = {{0x1000, 128, 0x26, 0, 1, SiiSyncManagerType::kMailboxOut},
+                    {0x1080, 128, 0x22, 0, 1, SiiSyncManagerType::kMailboxIn},
+                    {0x1100, 0, 0x64, 0, 1, SiiSyncManagerType::kOutputs},
+                    {0x1180, 0, 0x20, 0, 1, SiiSyncManagerType::kInputs}};
+  c.fmmus = {SiiFmmuUsage::kOutputs, SiiFmmuUsage::kInputs, SiiFmmuUsage::kSyncManagerStatus};
+  c.rxPdos.clear();
+  c.txPdos.clear();
+  return c;
+}
+
+inline std::unique_ptr<slavesim::Slave> makeCoeSlave(
+    const std::string& name, std::uint32_t product,
+    std::shared_ptr<slavesim::coe::ObjectDictionary> od, slavesim::SlaveProfile profile = {},
+    slavesim::coe::CoeServerOptions options = {}) {
+  auto slave = makeSiiSlave(name, coeSii(name, product), std::move(profile));
+  slave->setMailboxServer(std::make_unique<slavesim::coe::CoeServer>(std::move(od), options));
+  return slave;
 }
 
 }  // namespace ecsim::testing
