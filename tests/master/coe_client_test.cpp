@@ -7,13 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include "config/esi.hpp"
-#include "master/esc_config.hpp"
-#include "master/scan.hpp"
-#include "master/state_change.hpp"
 #include "slavesim/coe/standard_objects.hpp"
-#include "slavesim/esi_slave.hpp"
-#include "tests/master/sim_network.hpp"
+#include "tests/master/bring_up.hpp"
 #include "tests/master/test_slaves.hpp"
 
 namespace ecsim::testing {
@@ -24,30 +19,11 @@ using master::SdoTask;
 
 constexpr std::uint16_t kLongText = 0x2100;  // added to the dictionary by the test
 
-EsiFile loadDemoEsi() {
-  auto file = loadEsiFile(std::string(ECSIM_SOURCE_DIR) + "/examples/esi/ecsim_devices.xml");
-  EXPECT_TRUE(file.ok()) << (file.ok() ? "" : file.error().message());
-  return file.ok() ? std::move(file).value() : EsiFile{};
-}
-
-std::unique_ptr<slavesim::Slave> makeEsiSlave(const EsiFile& file, std::uint32_t product,
-                                              const std::string& name) {
-  for (const auto& device : file.devices) {
-    if (device.productCode != product) continue;
-    auto slave = slavesim::makeSlaveFromEsi(file, device, name);
-    EXPECT_TRUE(slave.ok()) << (slave.ok() ? "" : slave.error().message());
-    if (slave.ok()) return std::move(slave).value();
-  }
-  ADD_FAILURE() << "no device " << product;
-  return nullptr;
-}
-
 class CoeClientTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    EsiFile file = loadDemoEsi();
-    net_.segment().addSlave(makeEsiSlave(file, 0x3102, "AI1"));
-    net_.segment().addSlave(makeEsiSlave(file, 0x7201, "Drive1"));
+    net_.segment().addSlave(makeDemoSlave(0x3102, "AI1"));
+    net_.segment().addSlave(makeDemoSlave(0x7201, "Drive1"));
     // A slave of ours whose server offers complete access (the demo devices do not).
     auto od = std::make_shared<slavesim::coe::ObjectDictionary>();
     slavesim::coe::addIdentityObject(*od, {kTestVendor, 0xCA, 1, 2});
@@ -58,20 +34,8 @@ class CoeClientTest : public ::testing::Test {
     od_->addString(kLongText, "Long text", std::string(300, 'x'),
                    slavesim::coe::access::kReadWrite);
     net_.start();
-    master::ScanTask scan(transport_, slaves_);
-    scan.start(now());
-    ASSERT_TRUE(master::runTask(scan, transport_, net_.bus(), kNsPerSecond).ok());
-    ASSERT_TRUE(scan.status().ok()) << scan.status().error().message();
-    master::DatagramBatch mailboxes;
-    for (const auto& s : slaves_) master::addMailboxSetup(mailboxes, s);
-    mailboxes.queueAll(transport_);
-    master::BatchWait wait(mailboxes);
-    ASSERT_TRUE(master::runTask(wait, transport_, net_.bus(), kNsPerSecond).ok());
-    ASSERT_TRUE(mailboxes.check().ok()) << mailboxes.check().error().message();
-    master::StateChangeTask preop(transport_, slaves_);
-    preop.start(AlState::kPreOp, now());
-    ASSERT_TRUE(master::runTask(preop, transport_, net_.bus(), kNsPerSecond).ok());
-    ASSERT_TRUE(preop.status().ok()) << preop.status().error().message();
+    auto status = scanAndPreOp(net_, transport_, slaves_);
+    ASSERT_TRUE(status.ok()) << status.error().message();
   }
   SimTime now() { return net_.clock().now(); }
 

@@ -15,8 +15,10 @@
 #include "protocol/sii.hpp"
 #include "slavesim/coe/coe_server.hpp"
 #include "slavesim/coe/object_dictionary.hpp"
+#include "slavesim/coe/standard_objects.hpp"
 #include "slavesim/esc_type.hpp"
 #include "slavesim/generic_slave.hpp"
+#include "slavesim/process_data.hpp"
 #include "slavesim/slave.hpp"
 
 namespace ecsim::testing {
@@ -112,6 +114,46 @@ inline std::unique_ptr<slavesim::Slave> makeCoeSlave(
     slavesim::coe::CoeServerOptions options = {}) {
   auto slave = makeSiiSlave(name, coeSii(name, product), std::move(profile));
   slave->setMailboxServer(std::make_unique<slavesim::coe::CoeServer>(std::move(od), options));
+  return slave;
+}
+
+// A dictionary with `outWords` UINT outputs (0x7000:n in RxPDO 0x1600 on SM2) and `inWords`
+// UINT inputs (0x6000:n in TxPDO 0x1A00 on SM3), assigned in 0x1C12 / 0x1C13.
+inline std::shared_ptr<slavesim::coe::ObjectDictionary> coeIoDictionary(std::uint32_t product,
+                                                                        std::uint8_t outWords,
+                                                                        std::uint8_t inWords) {
+  namespace coe = slavesim::coe;
+  auto od = std::make_shared<coe::ObjectDictionary>();
+  coe::addIdentityObject(*od, {kTestVendor, product, 1, 0});
+  const std::uint8_t types[] = {1, 2, 3, 4};
+  coe::addSyncManagerTypes(*od, types);
+  od->addArray(0x7000, "Outputs", 0x0006, 16, outWords,
+               coe::access::kReadWrite | coe::access::kRxMappable);
+  od->addArray(0x6000, "Inputs", 0x0006, 16, inWords,
+               coe::access::kReadOnly | coe::access::kTxMappable);
+  coe::PdoMappingSpec rx{0x1600, "Out", {}, {}, outWords, true};
+  for (std::uint8_t i = 1; i <= outWords; ++i) rx.entries.push_back({0x7000, i, 16});
+  coe::PdoMappingSpec tx{0x1A00, "In", {}, {}, inWords, true};
+  for (std::uint8_t i = 1; i <= inWords; ++i) tx.entries.push_back({0x6000, i, 16});
+  coe::addPdoMapping(*od, rx);
+  coe::addPdoMapping(*od, tx);
+  const std::uint16_t rxPdos[] = {0x1600};
+  const std::uint16_t txPdos[] = {0x1A00};
+  coe::addPdoAssignment(*od, 2, rxPdos, 1, false);
+  coe::addPdoAssignment(*od, 3, txPdos, 1, false);
+  return od;
+}
+
+// A CoE slave of ours with the dictionary above and the simulator's process-data device:
+// its firmware checks the SM lengths at PREOP->SAFEOP and copies process data.
+inline std::unique_ptr<slavesim::Slave> makeCoeIoSlave(const std::string& name,
+                                                       std::uint32_t product, std::uint8_t outWords,
+                                                       std::uint8_t inWords) {
+  auto od = coeIoDictionary(product, outWords, inWords);
+  slavesim::SlaveProfile profile;
+  profile.mailbox = slavesim::SlaveProfile::Mailbox{0x1000, 128, 0x1080, 128};
+  auto slave = makeCoeSlave(name, product, od, profile);
+  slave->setDevice(std::make_unique<slavesim::ProcessDataDevice>(od));
   return slave;
 }
 

@@ -1,0 +1,60 @@
+// Test steps shared by the master tests: scan the simulated bus and bring every slave to
+// PREOP with its mailbox configured, using the master's own tasks.
+#pragma once
+
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "config/esi.hpp"
+#include "master/batch.hpp"
+#include "master/esc_config.hpp"
+#include "master/scan.hpp"
+#include "master/state_change.hpp"
+#include "slavesim/esi_slave.hpp"
+#include "tests/master/sim_network.hpp"
+
+namespace ecsim::testing {
+
+inline Status scanAndPreOp(SimNetwork& net, master::Transport& transport,
+                           std::vector<master::SlaveInfo>& slaves) {
+  master::ScanTask scan(transport, slaves);
+  scan.start(net.clock().now());
+  ECSIM_TRY(master::runTask(scan, transport, net.bus(), kNsPerSecond));
+  ECSIM_TRY(scan.status());
+  master::DatagramBatch mailboxes;
+  for (const auto& s : slaves) master::addMailboxSetup(mailboxes, s);
+  mailboxes.queueAll(transport);
+  master::BatchWait wait(mailboxes);
+  ECSIM_TRY(master::runTask(wait, transport, net.bus(), kNsPerSecond));
+  ECSIM_TRY(mailboxes.check());
+  master::StateChangeTask preop(transport, slaves);
+  preop.start(AlState::kPreOp, net.clock().now());
+  ECSIM_TRY(master::runTask(preop, transport, net.bus(), kNsPerSecond));
+  return preop.status();
+}
+
+inline const EsiFile& demoEsi() {
+  static const EsiFile file = [] {
+    auto f = loadEsiFile(std::string(ECSIM_SOURCE_DIR) + "/examples/esi/ecsim_devices.xml");
+    EXPECT_TRUE(f.ok()) << (f.ok() ? "" : f.error().message());
+    return f.ok() ? std::move(f).value() : EsiFile{};
+  }();
+  return file;
+}
+
+// A slave of ecsim's demo ESI file (examples/esi/ecsim_devices.xml) by product code.
+inline std::unique_ptr<slavesim::Slave> makeDemoSlave(std::uint32_t product,
+                                                      const std::string& name) {
+  const EsiFile& file = demoEsi();
+  for (const auto& device : file.devices) {
+    if (device.productCode != product) continue;
+    auto slave = slavesim::makeSlaveFromEsi(file, device, name);
+    EXPECT_TRUE(slave.ok()) << (slave.ok() ? "" : slave.error().message());
+    if (slave.ok()) return std::move(slave).value();
+  }
+  ADD_FAILURE() << "no demo device with product code " << product;
+  return nullptr;
+}
+
+}  // namespace ecsim::testing
