@@ -81,8 +81,12 @@ TEST(ScanTest, NothingConnectedSaysNoSlavesFound) {
 TEST(ScanTest, SiiCategoriesParsedWithFourAndEightByteReads) {
   SimNetwork net;
   const SiiContents io = ioSii("IO4", 0x2004, 4, 2, 77);
-  net.segment().addSlave(makeSiiSlave("IO4", io, {}, slavesim::kEt1100));    // 4-byte reads
-  net.segment().addSlave(makeSiiSlave("IO4b", io, {}, slavesim::kLan9252));  // 8-byte reads
+  slavesim::EscType fourBytes = slavesim::kEt1100;
+  fourBytes.siiRead8Bytes = false;
+  slavesim::EscType eightBytes = slavesim::kEt1100;
+  eightBytes.siiRead8Bytes = true;
+  net.segment().addSlave(makeSiiSlave("IO4", io, {}, fourBytes));
+  net.segment().addSlave(makeSiiSlave("IO4b", io, {}, eightBytes));
   net.segment().wireLine();
   net.start();
   auto result = scan(net);
