@@ -56,7 +56,11 @@ Result<TopologySlave> parseSlave(const xml::Context& ctx, const Element* e,
   ECSIM_ASSIGN_OR_RETURN(s.productCode, xml::attrNumber<std::uint32_t>(ctx, e, "product"));
   ECSIM_ASSIGN_OR_RETURN(s.revision, xml::attrNumber<std::uint32_t>(ctx, e, "revision"));
   if (const char* device = e->Attribute("device")) s.builtin = device;
-  if (s.esiFile.empty() && s.builtin.empty()) s.builtin = "generic";
+  if (const char* eeprom = e->Attribute("eeprom")) s.eepromFile = folder / eeprom;
+  if (!s.eepromFile.empty() && (!s.esiFile.empty() || !s.builtin.empty())) {
+    return ctx.error(e, "Slave '" + s.name + "': eeprom cannot be combined with esi or device");
+  }
+  if (s.esiFile.empty() && s.builtin.empty() && s.eepromFile.empty()) s.builtin = "generic";
   if (!s.esiFile.empty() && !s.productCode) {
     return ctx.error(e, "Slave '" + s.name + "' names an ESI file but no product code");
   }

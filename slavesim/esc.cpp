@@ -108,7 +108,7 @@ Esc::Esc(const EscType& type, std::vector<std::uint8_t> siiImage)
     : type_(type),
       memory_(kRamStart + static_cast<std::size_t>(type.ramKb) * 1024, 0),
       writable_(ecatWriteMasks()),
-      buffers_(3 * static_cast<std::size_t>(type.ramKb) * 1024, 0),
+      buffers_(3 * (kRamStart + static_cast<std::size_t>(type.ramKb) * 1024), 0),
       sii_(std::move(siiImage)) {
   lastMailboxResponse_.resize(static_cast<std::size_t>(type.ramKb) * 1024);
   scratch_.resize(kMaxDatagramLength + 1);
@@ -272,19 +272,20 @@ bool Esc::readMemory(std::uint32_t address, Bytes out, bool orInto) {
       any = true;
       break;
     }
-    if (at < kRamStart) {
-      std::uint32_t n = std::min<std::uint32_t>(address + size, kRamStart) - at;
-      for (std::uint32_t i = 0; i < n; ++i) {
-        piece[i] = orInto ? static_cast<std::uint8_t>(piece[i] | memory_[at + i]) : memory_[at + i];
-      }
-      any = true;
-      at += n;
-      continue;
-    }
-    // Process RAM: split at SyncManager boundaries.
+    // SyncManagers may cover process RAM and the upper register area (digital I/O terminals
+    // put their output SM at 0x0F00): split the access at SM boundaries first.
     auto a16 = static_cast<std::uint16_t>(at);
     std::uint32_t limit = std::min(address + size, memEnd);
     int smIndex = smLookup(at, limit);
+    if (smIndex < 0 && at < kRamStart) {
+      std::uint32_t n = std::min<std::uint32_t>(limit, kRamStart) - at;
+      for (std::uint32_t i = 0; i < n; ++i) {
+        piece[i] = orInto ? static_cast<std::uint8_t>(piece[i] | memory_[at + i]) : memory_[at + i];
+      }
+      any |= implemented(at, n);
+      at += n;
+      continue;
+    }
     std::uint32_t n = limit - at;
     if (readRam(a16, piece.first(n), orInto, smIndex)) any = true;
     at += n;
@@ -304,21 +305,46 @@ bool Esc::writeMemory(std::uint32_t address, ConstBytes data) {
       any = true;  // accepted and ignored
       break;
     }
-    if (at < kRamStart) {
-      std::uint32_t n = std::min<std::uint32_t>(address + size, kRamStart) - at;
-      writeRegisters(static_cast<std::uint16_t>(at), piece.first(n));
-      any = true;
-      at += n;
-      continue;
-    }
     auto a16 = static_cast<std::uint16_t>(at);
     std::uint32_t limit = std::min(address + size, memEnd);
     int smIndex = smLookup(at, limit);
+    if (smIndex < 0 && at < kRamStart) {
+      std::uint32_t n = std::min<std::uint32_t>(limit, kRamStart) - at;
+      writeRegisters(static_cast<std::uint16_t>(at), piece.first(n));
+      any |= implemented(at, n);
+      at += n;
+      continue;
+    }
     std::uint32_t n = limit - at;
     if (writeRam(a16, piece.first(n), smIndex)) any = true;
     at += n;
   }
   return any;
+}
+
+bool Esc::implemented(std::uint32_t at, std::uint32_t n) const {
+  // Registers of FMMU and SM channels beyond what the ESC has do not exist: an access that
+  // touches only those gets no working-counter increment (seen on real ET1200 terminals,
+  // docs/fidelity.md). Everything else in the register space answers.
+  const std::uint32_t end = at + n;
+  const std::uint32_t fmmuEnd =
+      reg::kFmmuBase + reg::kFmmuSize * static_cast<std::uint32_t>(type_.fmmus);
+  const std::uint32_t smEnd =
+      reg::kSmBase + reg::kSmSize * static_cast<std::uint32_t>(type_.syncManagers);
+  for (std::uint32_t a = at; a < end; ++a) {
+    if (a >= reg::kFmmuBase && a < reg::kFmmuBase + reg::kFmmuSize * reg::kMaxFmmus) {
+      if (a < fmmuEnd) return true;
+      a = reg::kFmmuBase + reg::kFmmuSize * reg::kMaxFmmus - 1;
+      continue;
+    }
+    if (a >= reg::kSmBase && a < reg::kSmBase + reg::kSmSize * reg::kMaxSyncManagers) {
+      if (a < smEnd) return true;
+      a = reg::kSmBase + reg::kSmSize * reg::kMaxSyncManagers - 1;
+      continue;
+    }
+    return true;
+  }
+  return false;
 }
 
 int Esc::smLookup(std::uint32_t at, std::uint32_t& limit) const {
@@ -349,8 +375,12 @@ Esc::SmConfig Esc::smConfig(unsigned s) const {
   c.start = readLe16(memory_, base + reg::sm::kPhysicalStart.address);
   c.length = readLe16(memory_, base + reg::sm::kLength.address);
   c.control = memory_[base + reg::sm::kControl.address];
-  c.enabled = (memory_[base + reg::sm::kActivate.address] & reg::sm::kActivateEnable) != 0 &&
-              (memory_[base + reg::sm::kPdiControl.address] & reg::sm::kPdiDeactivate) == 0;
+  // An SM that does not exist on this ESC, or whose area runs past the ESC's memory, never
+  // works: treated as disabled (so no buffer logic can reach outside the memory).
+  c.enabled = s < type_.syncManagers &&
+              (memory_[base + reg::sm::kActivate.address] & reg::sm::kActivateEnable) != 0 &&
+              (memory_[base + reg::sm::kPdiControl.address] & reg::sm::kPdiDeactivate) == 0 &&
+              static_cast<std::size_t>(c.start) + c.length <= memory_.size();
   return c;
 }
 
@@ -405,7 +435,7 @@ bool Esc::readRam(std::uint16_t address, Bytes out, bool orInto, int smIndex) {
   }
   // 3-buffer mode: the master reads the newest complete buffer the PDI wrote.
   const std::size_t offset = static_cast<std::size_t>(address - cfg.start);
-  const std::size_t bufBase = 3u * static_cast<std::size_t>(cfg.start - kRamStart);
+  const std::size_t bufBase = 3u * static_cast<std::size_t>(cfg.start);
   if (isEcatWrite(cfg.control)) {
     // Reading back an output SM gives the newest complete buffer as well.
     copyOut(&buffers_[bufBase + st.latest * cfg.length + offset]);
@@ -442,7 +472,7 @@ bool Esc::writeRam(std::uint16_t address, ConstBytes data, int smIndex) {
   }
   if (!isEcatWrite(cfg.control)) return false;  // inputs: master writes are ignored
   const std::size_t offset = static_cast<std::size_t>(address - cfg.start);
-  const std::size_t bufBase = 3u * static_cast<std::size_t>(cfg.start - kRamStart);
+  const std::size_t bufBase = 3u * static_cast<std::size_t>(cfg.start);
   std::copy(
       data.begin(), data.end(),
       buffers_.begin() + static_cast<std::ptrdiff_t>(bufBase + st.writing * cfg.length + offset));
@@ -814,7 +844,7 @@ ConstBytes Esc::pdiOutputs(unsigned s) const {
   if (s >= type_.syncManagers) return {};
   auto c = smConfig(s);
   if (!c.enabled || isMailbox(c.control) || !isEcatWrite(c.control) || c.length == 0) return {};
-  const std::size_t bufBase = 3u * static_cast<std::size_t>(c.start - kRamStart);
+  const std::size_t bufBase = 3u * static_cast<std::size_t>(c.start);
   return ConstBytes(buffers_.data() + bufBase + sm_[s].latest * c.length, c.length);
 }
 
@@ -823,7 +853,7 @@ bool Esc::pdiWriteInputs(unsigned s, ConstBytes data) {
   auto c = smConfig(s);
   if (!c.enabled || isMailbox(c.control) || isEcatWrite(c.control) || c.length == 0) return false;
   auto& st = sm_[s];
-  const std::size_t bufBase = 3u * static_cast<std::size_t>(c.start - kRamStart);
+  const std::size_t bufBase = 3u * static_cast<std::size_t>(c.start);
   std::size_t n = std::min<std::size_t>(data.size(), c.length);
   std::copy_n(data.begin(), n,
               buffers_.begin() + static_cast<std::ptrdiff_t>(bufBase + st.writing * c.length));

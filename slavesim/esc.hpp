@@ -192,6 +192,8 @@ class Esc {
   // The enabled SM covering `at` (or -1); lowers `limit` to where that SM, or the next SM
   // above `at`, ends or starts, so callers split accesses at SM boundaries.
   int smLookup(std::uint32_t at, std::uint32_t& limit) const;
+  // False when [at, at + n) lies entirely in registers this ESC type does not have.
+  bool implemented(std::uint32_t at, std::uint32_t n) const;
   void rebuildSmCache();
   void afterPdiWrite(std::uint16_t address) {
     if (address >= reg::kFmmuBase && address < reg::kFmmuBase + reg::kFmmuSize * reg::kMaxFmmus) {

@@ -28,12 +28,15 @@ struct EscType {
 };
 
 // ET1100: 8 FMMUs, 8 SMs, 8 KB process RAM, 4 ports, 64-bit DC (section II "ESC Features"
-// 0x01FC as SOEM sees it on real ET1100 terminals, notes/soem-interop.md §3.2).
+// 0x01FC as SOEM sees it on real ET1100 terminals, notes/soem-interop.md §3.2). 8-byte SII
+// reads: a real EK1100 reports 0x0502 bit 6 set (../shared/pcap/replay-dc.pcapng frame 102).
 inline constexpr EscType kEt1100{EscKind::kEt1100, "ET1100", 0x11, 0x00, 0x0002, 8, 8, 8,
-                                 0x01FC,           false,    4,    1000, 1000};
-// ET1200: 3 FMMUs, 4 SMs, 1 KB process RAM, up to 3 ports (datasheet section III ET1200).
+                                 0x01FC,           true,     4,    1000, 1000};
+// ET1200: 3 FMMUs, 4 SMs, 1 KB process RAM, up to 3 ports (datasheet section III ET1200);
+// real EL2828/EL2889 terminals answer only for FMMU0-2 and SM0-3 and report 8-byte SII reads
+// (replay-dc.pcapng).
 inline constexpr EscType kEt1200{EscKind::kEt1200, "ET1200", 0x12, 0x00, 0x0001, 3, 4, 1,
-                                 0x01FC,           false,    3,    1000, 1000};
+                                 0x01FC,           true,     3,    1000, 1000};
 // LAN9252 (Microchip): 3 FMMUs, 4 SMs, 4 KB process RAM, 2 ports, 64-bit DC.
 inline constexpr EscType kLan9252{
     EscKind::kLan9252, "LAN9252", 0xC0, 0x01, 0x0001, 3, 4, 4, 0x01FC, true, 2, 1000, 1000};

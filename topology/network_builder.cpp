@@ -1,5 +1,8 @@
 #include "topology/network_builder.hpp"
 
+#include <fstream>
+
+#include "protocol/sii.hpp"
 #include "slavesim/esi_slave.hpp"
 #include "slavesim/generic_slave.hpp"
 
@@ -19,6 +22,23 @@ Error at(const TopologySlave& entry, std::string message) {
                    "line " + std::to_string(entry.line) + ": " + std::move(message));
 }
 
+// A device known only by its SII EEPROM dump (a real terminal's, for replaying captures): the
+// ESC with that image, its standard mailbox as the SII gives it, no application behind it.
+Result<std::unique_ptr<slavesim::Slave>> makeFromEeprom(const TopologySlave& entry,
+                                                        const slavesim::EscType& esc) {
+  std::ifstream in(entry.eepromFile, std::ios::binary);
+  if (!in) return at(entry, "cannot read EEPROM image " + entry.eepromFile.string());
+  std::vector<std::uint8_t> image((std::istreambuf_iterator<char>(in)), {});
+  auto contents = SiiImage::parseLenient(image);
+  slavesim::SlaveProfile profile;
+  if (contents.ok() && contents->contents().standardMailbox.receiveSize > 0) {
+    const auto& m = contents->contents().standardMailbox;
+    profile.mailbox =
+        slavesim::SlaveProfile::Mailbox{m.receiveOffset, m.receiveSize, m.sendOffset, m.sendSize};
+  }
+  return std::make_unique<slavesim::Slave>(entry.name, esc, std::move(image), std::move(profile));
+}
+
 }  // namespace
 
 Result<std::unique_ptr<slavesim::Slave>> SlaveFactory::make(const TopologySlave& entry) {
@@ -32,6 +52,7 @@ Result<std::unique_ptr<slavesim::Slave>> SlaveFactory::make(const TopologySlave&
                                       esc.value_or(slavesim::kEt1100));
   }
   if (!entry.builtin.empty()) return at(entry, "unknown built-in device '" + entry.builtin + "'");
+  if (!entry.eepromFile.empty()) return makeFromEeprom(entry, esc.value_or(slavesim::kEt1100));
   auto found = esiFiles_.find(entry.esiFile);
   if (found == esiFiles_.end()) {
     auto file = loadEsiFile(entry.esiFile);

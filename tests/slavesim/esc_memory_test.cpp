@@ -183,14 +183,16 @@ TEST_F(Memory, SmRegistersLockedWhileEnabled) {
   EXPECT_EQ(esc(0).smConfig(2).start, 0x1200);
 }
 
-TEST_F(Memory, SiiReadLoadsTwoWordsPerCommand) {
+TEST_F(Memory, SiiReadLoadsFourWordsPerCommand) {
   // Read command for word 0x0008 (vendor id), then the data register.
   one(seg_, Command::kFpwr, phys(0x1001, 0x0502), {0x00, 0x01, 0x08, 0x00, 0x00, 0x00});
   auto status = one(seg_, Command::kFprd, phys(0x1001, 0x0502), {0, 0});
   EXPECT_EQ(readLe16(status.data, 0) & 0x8000, 0) << "not busy";
-  EXPECT_EQ(readLe16(status.data, 0) & 0x0040, 0) << "ET1100 reads 4 bytes";
-  auto data = one(seg_, Command::kFprd, phys(0x1001, 0x0508), {0, 0, 0, 0});
-  EXPECT_EQ(readLe32(data.data, 0), 0x0000ABCDu);
+  EXPECT_EQ(readLe16(status.data, 0) & 0x0040, 0x0040)
+      << "ET1100 reads 8 bytes, as a real EK1100 reports (replay-dc.pcapng frame 102)";
+  auto data = one(seg_, Command::kFprd, phys(0x1001, 0x0508), std::vector<std::uint8_t>(8, 0));
+  EXPECT_EQ(readLe32(data.data, 0), 0x0000ABCDu) << "word 8-9: vendor";
+  EXPECT_EQ(readLe32(data.data, 4), 0x00000100u) << "word A-B: product of slave 0";
   one(seg_, Command::kFpwr, phys(0x1002, 0x0502), {0x00, 0x01, 0x0A, 0x00, 0x00, 0x00});
   EXPECT_EQ(readLe32(one(seg_, Command::kFprd, phys(0x1002, 0x0508), {0, 0, 0, 0}).data, 0),
             0x101u);

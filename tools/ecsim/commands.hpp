@@ -13,5 +13,6 @@ CommandRunner addServeCommand(CLI::App& app);
 CommandRunner addDemoCommand(CLI::App& app);
 CommandRunner addNetCommand(CLI::App& app);
 CommandRunner addStudyCommand(CLI::App& app);
+CommandRunner addReplayCommand(CLI::App& app);
 
 }  // namespace ecsim::tools

@@ -12,12 +12,14 @@ int main(int argc, char** argv) {
   auto demo = ecsim::tools::addDemoCommand(app);
   auto net = ecsim::tools::addNetCommand(app);
   auto study = ecsim::tools::addStudyCommand(app);
+  auto replay = ecsim::tools::addReplayCommand(app);
   CLI11_PARSE(app, argc, argv);
   try {
     if (app.got_subcommand("serve")) return serve();
     if (app.got_subcommand("demo")) return demo();
     if (app.got_subcommand("net")) return net();
     if (app.got_subcommand("study")) return study();
+    if (app.got_subcommand("replay")) return replay();
   } catch (const std::exception& e) {
     fmt::print(stderr, "ecsim: {}\n", e.what());
     return 1;

@@ -1,0 +1,72 @@
+// `ecsim replay CAPTURE [--topology FILE]`: feed the master's frames of a capture to a
+// simulated network and report, frame by frame, where the answers differ from the recorded.
+#include <fmt/core.h>
+
+#include "config/topology_file.hpp"
+#include "link/pcap.hpp"
+#include "tools/ecsim/commands.hpp"
+#include "topology/network_builder.hpp"
+#include "topology/replay.hpp"
+
+namespace ecsim::tools {
+namespace {
+
+struct ReplayOptions {
+  std::string capture;
+  std::string topology;
+  std::size_t show{40};
+};
+
+int runReplay(const ReplayOptions& o) {
+  auto records = PcapReader::readAll(o.capture);
+  if (!records.ok()) {
+    fmt::print(stderr, "ecsim replay: {}\n", records.error().message());
+    return 1;
+  }
+  std::string topologyPath =
+      o.topology.empty() ? std::string(ECSIM_SOURCE_DATA_DIR "/topologies/demo.xml") : o.topology;
+  auto config = loadTopologyFile(topologyPath);
+  if (!config.ok()) {
+    fmt::print(stderr, "ecsim replay: {}\n", config.error().message());
+    return 1;
+  }
+  auto network = topology::buildNetwork(*config);
+  if (!network.ok()) {
+    fmt::print(stderr, "ecsim replay: {}\n", network.error().message());
+    return 1;
+  }
+  auto report = topology::replayCapture(*records, *network->segment);
+  if (!report.ok()) {
+    fmt::print(stderr, "ecsim replay: {}\n", report.error().message());
+    return 1;
+  }
+  const auto& r = *report;
+  std::size_t shown = 0;
+  for (const auto& d : r.differences) {
+    if (shown++ == o.show) {
+      fmt::print("... {} more differences\n", r.differences.size() - o.show);
+      break;
+    }
+    fmt::print("{}\n", d.describe());
+  }
+  fmt::print(
+      "\n{}: {} frames ({} not EtherCAT), {} from the master, {} unanswered in the capture\n"
+      "datagrams compared {}: WKC differs {}, data differs {} (+{} only in DC time registers)\n",
+      o.capture, r.framesInCapture, r.otherFrames, r.masterFrames, r.unanswered, r.datagrams,
+      r.wkcMismatches, r.dataMismatches, r.timeDataMismatches);
+  fmt::print("{}\n", r.identical() ? "identical" : "differences found");
+  return r.identical() ? 0 : 3;
+}
+
+}  // namespace
+
+CommandRunner addReplayCommand(CLI::App& app) {
+  auto opts = std::make_shared<ReplayOptions>();
+  auto* cmd = app.add_subcommand("replay", "Replay a capture's master frames and compare answers");
+  cmd->add_option("capture", opts->capture, "pcap or pcapng file")->required();
+  cmd->add_option("--topology", opts->topology, "Topology to replay against (default: demo)");
+  cmd->add_option("--show", opts->show, "Differences to print");
+  return [opts] { return runReplay(*opts); };
+}
+
+}  // namespace ecsim::tools
