@@ -61,7 +61,8 @@ class SoemRun {
     const std::string tag = std::to_string(::getpid()) + "_" + std::to_string(counter_++);
     serveLog_ = ::testing::TempDir() + "soem_serve_" + tag + ".log";
     const std::string outLog = ::testing::TempDir() + "soem_out_" + tag + ".log";
-    std::vector<std::string> serve{kEcsim, "serve", "--iface", ns->simulatorInterface()};
+    // --rt: answers must come within SOEM's 2 ms even when the host is busy (CI builds).
+    std::vector<std::string> serve{kEcsim, "serve", "--rt", "--iface", ns->simulatorInterface()};
     serve.insert(serve.end(), serveArgs_.begin(), serveArgs_.end());
     auto server = ns->spawn(serve, SpawnOptions{serveLog_, serveLog_});
     EXPECT_TRUE(server.ok());

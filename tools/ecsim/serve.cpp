@@ -2,7 +2,12 @@
 // TAP device, or a real NIC) as a line of simulated slaves.
 #include <fmt/core.h>
 
+#include <sched.h>
+#include <sys/mman.h>
+
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -34,6 +39,7 @@ struct ServeOptions {
   unsigned slaves{0};  // 0: not given
   bool paced{false};
   bool quiet{false};
+  bool realtime{false};
 };
 
 // The built-in demo network: the installed copy, else the one in the source tree.
@@ -144,6 +150,21 @@ int runServe(ServeOptions o) {
   }
   Link* served = link.get();
 
+  if (o.realtime) {
+    // Answer within the master's timeout even on a loaded host: SCHED_FIFO and locked memory
+    // when permitted (root or CAP_SYS_NICE), a clear warning otherwise.
+    sched_param param{};
+    param.sched_priority = 80;
+    if (sched_setscheduler(0, SCHED_FIFO, &param) != 0) {
+      fmt::print(stderr,
+                 "ecsim serve: warning: SCHED_FIFO not permitted ({}); running with "
+                 "normal priority\n",
+                 std::strerror(errno));
+    }
+    if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
+      fmt::print(stderr, "ecsim serve: warning: mlockall failed ({})\n", std::strerror(errno));
+    }
+  }
   topology::ServerOptions options;
   options.paced = o.paced;
   options.idleWait = std::chrono::milliseconds(10);
@@ -188,6 +209,7 @@ CommandRunner addServeCommand(CLI::App& app) {
   cmd->add_option("--pcap", opts->pcap, "Capture every frame to this pcap file");
   cmd->add_flag("--paced", opts->paced, "Answer at the modelled round-trip time");
   cmd->add_flag("--quiet", opts->quiet, "Print only the final statistics");
+  cmd->add_flag("--rt", opts->realtime, "Run with SCHED_FIFO priority and locked memory");
   return [opts] { return runServe(*opts); };
 }
 
