@@ -33,7 +33,8 @@ inline SiiContents ioSii(const std::string& name, std::uint32_t product, std::ui
   SiiContents c;
   c.config.pdiControl = 0x0004;  // digital I/O PDI
   c.identity = {kTestVendor, product, 0x00020000, serial};
-  c.sizeField = siiSizeFieldForBytes(2048);
+  // 16 Kbit; a large image's PDO list needs a 128 Kbit EEPROM.
+  c.sizeField = siiSizeFieldForBytes(outBytes > 200 ? 16384 : 2048);
   c.strings = {name, "Outputs", "Inputs", "Out", "In"};
   SiiGeneral g;
   g.nameIndex = 1;
@@ -46,13 +47,16 @@ inline SiiContents ioSii(const std::string& name, std::uint32_t product, std::ui
       kIoInputSm, static_cast<std::uint16_t>(2 * inWords), 0x20,
       0,          SiiSyncManagerEnable::kEnable,           SiiSyncManagerType::kInputs};
   c.syncManagers = {out, in};
-  if (outBytes > 0) {
+  // One 8-bit entry per output byte; an SII PDO holds at most 255 entries, so large images
+  // use 0x1600, 0x1601, ... with up to 200 entries each.
+  for (std::uint16_t first = 0; first < outBytes; first = static_cast<std::uint16_t>(first + 200)) {
     SiiPdo rx;
-    rx.index = 0x1600;
+    rx.index = static_cast<std::uint16_t>(0x1600 + first / 200);
     rx.syncManager = 0;
     rx.nameIndex = 2;
-    for (std::uint16_t i = 0; i < outBytes; ++i) {
-      rx.entries.push_back({0x7000, static_cast<std::uint8_t>(i + 1), 4, 0x05, 8, 0});
+    for (std::uint16_t i = first; i < outBytes && i < first + 200; ++i) {
+      rx.entries.push_back({static_cast<std::uint16_t>(0x7000 + i / 200),
+                            static_cast<std::uint8_t>(i % 200 + 1), 4, 0x05, 8, 0});
     }
     c.rxPdos.push_back(rx);
   }

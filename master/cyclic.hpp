@@ -1,0 +1,104 @@
+// Cyclic process-data exchange from cached frames. build() makes the LRW frames of a layout
+// once (allocating); afterwards a cycle is
+//
+//   send(image)     abandon any frame of the last cycle still unanswered (it counts as lost),
+//                   copy the output bytes of the image into the frames, send each under a
+//                   fresh index
+//   ...             the transport receives the answers into the frames' receive buffers
+//   finish(image)   copy the input bytes of every answered frame into the image, compare each
+//                   datagram's WKC with its expected value; a mismatch names the datagram and
+//                   the slaves it touches (a view into the layout: nothing is allocated)
+//
+// Neither send() nor finish() allocates.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "master/process_image.hpp"
+#include "master/transport.hpp"
+
+namespace ecsim::master {
+
+struct WkcMismatch {
+  std::size_t datagram{0};  // index into the layout's datagrams
+  std::uint32_t logicalStart{0};
+  std::uint16_t length{0};
+  std::uint16_t expected{0};
+  std::uint16_t actual{0};
+  std::span<const std::size_t> slaves;  // positions of the slaves the datagram touches
+  // "LRW 0x00000000+16: working counter 4, expected 6; slaves 0 (0x1001 'A'), 2 (...)"
+  std::string describe(const std::vector<SlaveInfo>& slaveInfos) const;
+};
+
+struct CycleResult {
+  std::size_t framesAnswered{0};
+  std::size_t framesLost{0};  // unanswered when the cycle was finished
+  std::size_t wkcErrors{0};   // datagrams answered with a WKC other than expected
+  std::optional<WkcMismatch> firstMismatch;
+  SimTime maxRoundTrip{0};
+  bool ok() const { return framesLost == 0 && wkcErrors == 0; }
+};
+
+struct CyclicStatistics {
+  std::uint64_t cycles{0};
+  std::uint64_t framesSent{0};
+  std::uint64_t framesLost{0};
+  std::uint64_t wkcErrors{0};         // datagrams
+  std::uint64_t cyclesWithErrors{0};  // lost frame or WKC error
+  std::uint64_t roundTrips{0};
+  SimTime roundTripMin{0};
+  SimTime roundTripMax{0};
+  SimTime roundTripSum{0};
+  SimTime roundTripMean() const {
+    return roundTrips == 0 ? 0 : roundTripSum / static_cast<SimTime>(roundTrips);
+  }
+};
+
+class CyclicExchange {
+ public:
+  CyclicExchange() = default;
+  CyclicExchange(const CyclicExchange&) = delete;
+  CyclicExchange& operator=(const CyclicExchange&) = delete;
+
+  // Builds the frames of `layout` (which must outlive this object). Any previous frames are
+  // dropped.
+  Status build(const ProcessImageLayout& layout, const MacAddress& source);
+  bool built() const { return layout_ != nullptr; }
+  std::size_t frameCount() const { return frames_.size(); }
+  const CachedFrame& frame(std::size_t n) const { return *frames_[n]; }
+
+  // `image` is the whole process image (layout.size() bytes).
+  Status send(Transport& transport, ConstBytes image, SimTime now);
+  // True while a frame of this cycle is in flight.
+  bool pending() const;
+  CycleResult finish(Bytes image);
+
+  const CyclicStatistics& statistics() const { return statistics_; }
+  void resetStatistics() { statistics_ = {}; }
+
+ private:
+  struct Copy {
+    std::size_t frame{0};
+    std::size_t frameOffset{0};  // of the data in the frame
+    std::uint32_t imageOffset{0};
+    std::uint32_t length{0};
+  };
+  struct DatagramRef {
+    std::size_t frame{0};
+    std::size_t index{0};  // within the frame
+  };
+
+  const ProcessImageLayout* layout_{nullptr};
+  std::vector<std::unique_ptr<CachedFrame>> frames_;
+  std::vector<DatagramRef> datagrams_;  // parallel to layout_->datagrams
+  std::vector<Copy> outputs_;
+  std::vector<Copy> inputs_;
+  CyclicStatistics statistics_{};
+};
+
+}  // namespace ecsim::master

@@ -1,0 +1,383 @@
+#include "master/master.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+#include "master/batch.hpp"
+#include "master/esc_config.hpp"
+
+namespace ecsim::master {
+namespace {
+
+constexpr std::uint16_t kAlStatusLength =
+    static_cast<std::uint16_t>(reg::kAlStatusCode.end() - reg::kAlStatus.address);
+
+int rank(AlState s) {
+  switch (s) {
+    case AlState::kInit:
+      return 0;
+    case AlState::kPreOp:
+      return 1;
+    case AlState::kBootstrap:
+      return 1;
+    case AlState::kSafeOp:
+      return 2;
+    case AlState::kOp:
+      return 3;
+  }
+  return 0;
+}
+
+// Steps several tasks side by side (their datagrams share frames).
+class TaskGroup final : public Task {
+ public:
+  void add(Task& task) { tasks_.push_back(&task); }
+  bool step(SimTime now) override {
+    bool running = false;
+    for (Task* t : tasks_) running = t->step(now) || running;
+    return running;
+  }
+  std::optional<SimTime> wakeAt() const override {
+    std::optional<SimTime> earliest;
+    for (const Task* t : tasks_) {
+      auto w = t->wakeAt();
+      if (w && (!earliest || *w < *earliest)) earliest = w;
+    }
+    return earliest;
+  }
+
+ private:
+  std::vector<Task*> tasks_;
+};
+
+// Runs `inner` while exchanging process data every `period`.
+class CyclingTask final : public Task {
+ public:
+  CyclingTask(Task& inner, CyclicExchange& cyclic, Transport& transport,
+              std::vector<std::uint8_t>& image, SimTime period)
+      : inner_(inner), cyclic_(cyclic), transport_(transport), image_(image), period_(period) {}
+  bool step(SimTime now) override {
+    const bool running = inner_.step(now);
+    if (!cyclic_.pending()) {
+      if (sent_) (void)cyclic_.finish(image_);
+      sent_ = false;
+      if (running && now >= next_) {
+        sent_ = cyclic_.send(transport_, image_, now).ok();
+        next_ = now + period_;
+      }
+    }
+    return running;
+  }
+  std::optional<SimTime> wakeAt() const override {
+    auto w = inner_.wakeAt();
+    return w ? std::min(*w, next_) : next_;
+  }
+
+ private:
+  Task& inner_;
+  CyclicExchange& cyclic_;
+  Transport& transport_;
+  std::vector<std::uint8_t>& image_;
+  SimTime period_;
+  SimTime next_{0};
+  bool sent_{false};
+};
+
+class CycleWait final : public Task {
+ public:
+  explicit CycleWait(const CyclicExchange& cyclic) : cyclic_(cyclic) {}
+  bool step(SimTime /*now*/) override { return cyclic_.pending(); }
+
+ private:
+  const CyclicExchange& cyclic_;
+};
+
+}  // namespace
+
+Master::Master(Link& link, Bus& bus, MasterOptions options)
+    : options_(options), transport_(link, options.transport), bus_(bus) {}
+
+Status Master::run(Task& task, SimTime timeout, std::string_view what) {
+  return runTask(task, transport_, bus_, timeout, what);
+}
+
+Status Master::loadConfig(const std::filesystem::path& path) {
+  ECSIM_ASSIGN_OR_RETURN(MasterConfig config, loadMasterConfig(path));
+  config_ = std::move(config);
+  return okStatus();
+}
+
+Result<SlaveInfo*> Master::slaveAt(std::size_t position) {
+  if (position >= slaves_.size()) {
+    return makeError(ErrorCode::kNotFound, "no slave at position " + std::to_string(position) +
+                                               " (the bus has " + std::to_string(slaves_.size()) +
+                                               ")");
+  }
+  return &slaves_[position];
+}
+
+Status Master::scan() {
+  processData_.clear();
+  layout_ = {};
+  image_.clear();
+  (void)cyclic_.build(layout_, options_.transport.source);
+  ScanTask task(transport_, slaves_, options_.scan);
+  task.start(bus_.now());
+  ECSIM_TRY(run(task, options_.scanTimeout, "scan"));
+  return task.status();
+}
+
+Status Master::setupMailboxes() {
+  DatagramBatch batch;
+  for (const auto& slave : slaves_) addMailboxSetup(batch, slave);
+  if (batch.empty()) return okStatus();
+  batch.queueAll(transport_);
+  BatchWait wait(batch);
+  ECSIM_TRY(run(wait, options_.state.timeout, "mailbox setup"));
+  if (auto s = batch.check(); !s.ok()) {
+    return makeError(s.error().code, "mailbox SyncManagers: " + s.error().context);
+  }
+  return okStatus();
+}
+
+Status Master::readStates() {
+  DatagramBatch batch;
+  for (const auto& slave : slaves_) {
+    batch.add().fprd(slave.station, reg::kAlStatus.address, kAlStatusLength);
+  }
+  batch.queueAll(transport_);
+  BatchWait wait(batch);
+  ECSIM_TRY(run(wait, options_.state.timeout, "AL status"));
+  ECSIM_TRY(batch.check());
+  for (std::size_t i = 0; i < slaves_.size(); ++i) {
+    slaves_[i].alStatus = readLe16(batch[i].data(), 0);
+    slaves_[i].alStatusCode =
+        readLe16(batch[i].data(), reg::kAlStatusCode.address - reg::kAlStatus.address);
+  }
+  return okStatus();
+}
+
+Status Master::requestState(AlState target) {
+  StateChangeTask task(transport_, slaves_, options_.state);
+  task.start(target, bus_.now());
+  const SimTime timeout = options_.state.timeout + kNsPerSecond;
+  Status ran;
+  if (cyclic_.built() && cyclic_.frameCount() > 0 && rank(target) >= rank(AlState::kSafeOp)) {
+    CyclingTask cycling(task, cyclic_, transport_, image_, options_.cycleTime);
+    ran = run(cycling, timeout, "state change");
+    CycleWait wait(cyclic_);
+    ECSIM_TRY(run(wait, 4 * options_.transport.timeout, "last cycle"));
+    if (!cyclic_.pending()) (void)cyclic_.finish(image_);
+  } else {
+    ran = run(task, timeout, "state change");
+  }
+  refusals_ = task.refusals();
+  ECSIM_TRY(ran);
+  return task.status();
+}
+
+Status Master::configureProcessData() {
+  processData_.assign(slaves_.size(), {});
+  std::vector<std::unique_ptr<PdoDiscoveryTask>> discoveries(slaves_.size());
+  TaskGroup group;
+  for (auto& slave : slaves_) {
+    if (!slave.hasCoe()) continue;
+    auto& task = discoveries[slave.position];
+    task = std::make_unique<PdoDiscoveryTask>(transport_, slave, &emergencies_, options_.mailbox);
+    ECSIM_TRY(task->start(bus_.now()));
+    group.add(*task);
+  }
+  ECSIM_TRY(run(group, options_.mailboxTimeout, "PDO discovery"));
+  for (auto& slave : slaves_) {
+    SlaveProcessData& data = processData_[slave.position];
+    if (const auto& task = discoveries[slave.position]) {
+      if (!task->status().ok()) {
+        return makeError(task->status().error().code,
+                         "PDO discovery: " + task->status().error().context);
+      }
+      data = task->result();
+    }
+    // CoE without bits (or no CoE): the SII says (as SOEM decides).
+    if (data.outputBits() + data.inputBits() == 0) data = processDataFromSii(slave);
+  }
+  ECSIM_ASSIGN_OR_RETURN(layout_, planProcessImage(slaves_, processData_, options_.layout));
+  if (layout_.frameCount > transport_.options().maxFramesInFlight) {
+    return makeError(ErrorCode::kTooLarge,
+                     "process image needs " + std::to_string(layout_.frameCount) +
+                         " frames per cycle, the transport allows " +
+                         std::to_string(transport_.options().maxFramesInFlight) + " in flight");
+  }
+  DatagramBatch batch;
+  addProcessDataSetup(batch, layout_);
+  batch.queueAll(transport_);
+  BatchWait wait(batch);
+  ECSIM_TRY(run(wait, options_.state.timeout, "SM/FMMU setup"));
+  if (auto s = batch.check(); !s.ok()) {
+    return makeError(s.error().code, "SM/FMMU setup: " + s.error().context);
+  }
+  image_.assign(layout_.size(), 0);
+  return cyclic_.build(layout_, options_.transport.source);
+}
+
+Status Master::bringTo(AlState target) {
+  ECSIM_TRY(readStates());
+  if (slaves_.empty()) return okStatus();
+  int lowest = rank(AlState::kOp);
+  int highest = rank(AlState::kInit);
+  for (const auto& s : slaves_) {
+    const int r = rank(s.state().value_or(AlState::kInit));
+    lowest = std::min(lowest, r);
+    highest = std::max(highest, r);
+  }
+  const int want = rank(target);
+  if (want <= lowest) return want == highest ? okStatus() : requestState(target);
+  if (lowest < rank(AlState::kPreOp)) {
+    ECSIM_TRY(setupMailboxes());
+    ECSIM_TRY(requestState(AlState::kPreOp));
+  }
+  if (want == rank(AlState::kPreOp)) return okStatus();
+  if (lowest < rank(AlState::kSafeOp)) {
+    ECSIM_TRY(configureProcessData());
+    ECSIM_TRY(requestState(AlState::kSafeOp));
+  }
+  if (want == rank(AlState::kSafeOp)) return okStatus();
+  if (!cyclic_.built()) ECSIM_TRY(configureProcessData());
+  (void)exchange();  // valid outputs in the slaves before OP is requested
+  return requestState(AlState::kOp);
+}
+
+Status Master::start() {
+  ECSIM_TRY(scan());
+  if (config_) ECSIM_TRY(checkIdentities(*config_, slaves_));
+  if (slaves_.empty()) return makeError(ErrorCode::kNotFound, "no slaves found");
+  return bringTo(AlState::kOp);
+}
+
+Status Master::stop() {
+  if (slaves_.empty()) return okStatus();
+  return requestState(AlState::kInit);
+}
+
+Status Master::writeData(std::size_t offset, ConstBytes data) {
+  if (offset + data.size() > layout_.outputBytes) {
+    return makeError(ErrorCode::kInvalidArgument,
+                     "writeData: bytes " + std::to_string(offset) + ".." +
+                         std::to_string(offset + data.size()) + " are not all outputs (" +
+                         std::to_string(layout_.outputBytes) + " output bytes)");
+  }
+  if (!data.empty()) std::memcpy(image_.data() + offset, data.data(), data.size());
+  return okStatus();
+}
+
+Status Master::readData(std::size_t offset, Bytes out) const {
+  if (offset + out.size() > image_.size()) {
+    return makeError(ErrorCode::kInvalidArgument,
+                     "readData: bytes " + std::to_string(offset) + ".." +
+                         std::to_string(offset + out.size()) + " outside the " +
+                         std::to_string(image_.size()) + "-byte process image");
+  }
+  if (!out.empty()) std::memcpy(out.data(), image_.data() + offset, out.size());
+  return okStatus();
+}
+
+Status Master::sendCycle() {
+  if (!cyclic_.built()) {
+    return makeError(ErrorCode::kState, "no process data configured (start() first)");
+  }
+  return cyclic_.send(transport_, image_, bus_.now());
+}
+
+CycleResult Master::finishCycle() {
+  return cyclic_.finish(image_);
+}
+
+Status Master::exchange() {
+  ECSIM_TRY(sendCycle());
+  CycleWait wait(cyclic_);
+  ECSIM_TRY(run(wait, 4 * options_.transport.timeout, "cycle"));
+  lastCycle_ = finishCycle();
+  if (lastCycle_.framesLost > 0) {
+    return makeError(ErrorCode::kTimeout,
+                     std::to_string(lastCycle_.framesLost) + " cyclic frame(s) lost");
+  }
+  if (lastCycle_.firstMismatch) {
+    return makeError(ErrorCode::kWorkingCounter, lastCycle_.firstMismatch->describe(slaves_));
+  }
+  return okStatus();
+}
+
+Result<std::vector<std::uint8_t>> Master::sdoUpload(std::size_t position, std::uint16_t index,
+                                                    std::uint8_t subindex, bool completeAccess) {
+  ECSIM_ASSIGN_OR_RETURN(SlaveInfo * slave, slaveAt(position));
+  SdoTask task(transport_, *slave, &emergencies_, options_.mailbox);
+  ECSIM_TRY(task.startUpload(index, subindex, completeAccess, bus_.now()));
+  ECSIM_TRY(run(task, options_.mailboxTimeout, "SDO upload"));
+  ECSIM_TRY(task.status());
+  return task.data();
+}
+
+Status Master::sdoDownload(std::size_t position, std::uint16_t index, std::uint8_t subindex,
+                           ConstBytes data, bool completeAccess) {
+  ECSIM_ASSIGN_OR_RETURN(SlaveInfo * slave, slaveAt(position));
+  SdoTask task(transport_, *slave, &emergencies_, options_.mailbox);
+  ECSIM_TRY(task.startDownload(index, subindex, data, completeAccess, bus_.now()));
+  ECSIM_TRY(run(task, options_.mailboxTimeout, "SDO download"));
+  return task.status();
+}
+
+Result<OdList> Master::readOdList(std::size_t position) {
+  ECSIM_ASSIGN_OR_RETURN(SlaveInfo * slave, slaveAt(position));
+  SdoInfoTask task(transport_, *slave, &emergencies_, options_.mailbox);
+  ECSIM_TRY(task.startOdList(OdListType::kAll, bus_.now()));
+  ECSIM_TRY(run(task, options_.mailboxTimeout, "OD list"));
+  ECSIM_TRY(task.status());
+  return std::get<OdList>(*task.response());
+}
+
+Result<ObjectDescription> Master::readObjectDescription(std::size_t position, std::uint16_t index) {
+  ECSIM_ASSIGN_OR_RETURN(SlaveInfo * slave, slaveAt(position));
+  SdoInfoTask task(transport_, *slave, &emergencies_, options_.mailbox);
+  ECSIM_TRY(task.startObjectDescription(index, bus_.now()));
+  ECSIM_TRY(run(task, options_.mailboxTimeout, "object description"));
+  ECSIM_TRY(task.status());
+  const auto* d = std::get_if<ObjectDescription>(&*task.response());
+  if (d == nullptr) return makeError(ErrorCode::kMalformed, "not an object description");
+  return *d;
+}
+
+Result<EntryDescription> Master::readEntryDescription(std::size_t position, std::uint16_t index,
+                                                      std::uint8_t subindex) {
+  ECSIM_ASSIGN_OR_RETURN(SlaveInfo * slave, slaveAt(position));
+  SdoInfoTask task(transport_, *slave, &emergencies_, options_.mailbox);
+  // Value info 0x07 asks for no unit/default/min/max (what SOEM asks).
+  ECSIM_TRY(task.startEntryDescription(index, subindex, 0x07, bus_.now()));
+  ECSIM_TRY(run(task, options_.mailboxTimeout, "entry description"));
+  ECSIM_TRY(task.status());
+  const auto* d = std::get_if<EntryDescription>(&*task.response());
+  if (d == nullptr) return makeError(ErrorCode::kMalformed, "not an entry description");
+  return *d;
+}
+
+Result<std::vector<std::uint8_t>> Master::readRegisters(std::size_t position, std::uint16_t address,
+                                                        std::uint16_t length) {
+  ECSIM_ASSIGN_OR_RETURN(SlaveInfo * slave, slaveAt(position));
+  DatagramBatch batch;
+  batch.add().fprd(slave->station, address, length);
+  batch.queueAll(transport_);
+  BatchWait wait(batch);
+  ECSIM_TRY(run(wait, options_.state.timeout, "register read"));
+  ECSIM_TRY(batch.check());
+  return std::vector<std::uint8_t>(batch[0].data().begin(), batch[0].data().end());
+}
+
+Status Master::writeRegisters(std::size_t position, std::uint16_t address, ConstBytes data) {
+  ECSIM_ASSIGN_OR_RETURN(SlaveInfo * slave, slaveAt(position));
+  DatagramBatch batch;
+  batch.add().fpwr(slave->station, address, data);
+  batch.queueAll(transport_);
+  BatchWait wait(batch);
+  ECSIM_TRY(run(wait, options_.state.timeout, "register write"));
+  return batch.check();
+}
+
+}  // namespace ecsim::master

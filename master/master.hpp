@@ -1,0 +1,132 @@
+// ecsim's EtherCAT master: the application API over the step-driven core.
+//
+//   Master master(link, bus);
+//   master.loadConfig("bus.xml");       // optional: the slaves expected, with identity
+//   master.start();                     // scan, identity check, mailboxes, PDO mapping from
+//                                       // CoE or SII, process image, SM/FMMU, INIT->PREOP->
+//                                       // SAFEOP->OP for all slaves together
+//   for (;;) {
+//     master.writeData(offset, outputs);  // process image offsets (layout(): outputs first)
+//     master.exchange();                  // one cycle: LRW frames out and back, WKC checked
+//     master.readData(offset, inputs);
+//   }
+//   master.stop();                      // all slaves back to INIT
+//
+// Every call blocks through the Bus (real time on an interface, virtual time in tests) but
+// the work is done by non-blocking state machines (master/scan.hpp, state_change.hpp,
+// coe_client.hpp, ...) that a real-time driver can step itself. Errors name the slave (position,
+// station address, name) and, for refusals, the AL status code and its text.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "link/link.hpp"
+#include "master/bus.hpp"
+#include "master/coe_client.hpp"
+#include "master/cyclic.hpp"
+#include "master/master_config.hpp"
+#include "master/pdo_config.hpp"
+#include "master/process_image.hpp"
+#include "master/scan.hpp"
+#include "master/slave_info.hpp"
+#include "master/state_change.hpp"
+#include "master/transport.hpp"
+
+namespace ecsim::master {
+
+struct MasterOptions {
+  TransportOptions transport;
+  ScanOptions scan;
+  StateChangeOptions state;
+  MailboxOptions mailbox;
+  LayoutOptions layout;
+  // While waiting for SAFEOP -> OP (and afterwards in start()), process data is exchanged
+  // this often so the slaves see valid outputs and their watchdogs stay calm.
+  SimTime cycleTime{kNsPerMs};
+  SimTime scanTimeout{30 * kNsPerSecond};
+  SimTime mailboxTimeout{10 * kNsPerSecond};  // one SDO transfer or PDO discovery
+};
+
+class Master {
+ public:
+  // link and bus must outlive the master.
+  Master(Link& link, Bus& bus, MasterOptions options = {});
+
+  // ---- the application API ------------------------------------------------------------------
+  Status loadConfig(const std::filesystem::path& path);
+  void setConfig(MasterConfig config) { config_ = std::move(config); }
+  const std::optional<MasterConfig>& config() const { return config_; }
+
+  Status start();
+  // Copies into the outputs of the process image (offset < layout().outputBytes).
+  Status writeData(std::size_t offset, ConstBytes data);
+  // Copies from the process image (outputs or inputs).
+  Status readData(std::size_t offset, Bytes out) const;
+  // One cycle: send the frames, wait for them (at most the transport timeout), copy inputs,
+  // check WKCs. kWorkingCounter naming the slaves concerned, kTimeout for a lost frame.
+  Status exchange();
+  Status stop();
+
+  // ---- steps and services (tools, tests) ----------------------------------------------------
+  Status scan();
+  Status setupMailboxes();
+  // One state for all slaves (no path through intermediate states); with process data
+  // configured and a target of SAFEOP or OP, cycles go on while waiting.
+  Status requestState(AlState target);
+  // Walks INIT -> PREOP -> SAFEOP -> OP (configuring on the way) up to `target`, or goes
+  // straight down.
+  Status bringTo(AlState target);
+  // Reads every slave's AL status and code.
+  Status readStates();
+  // PDO discovery (CoE, else SII), process image, SM/FMMU writes; slaves must be in PREOP.
+  Status configureProcessData();
+
+  Result<std::vector<std::uint8_t>> sdoUpload(std::size_t position, std::uint16_t index,
+                                              std::uint8_t subindex, bool completeAccess = false);
+  Status sdoDownload(std::size_t position, std::uint16_t index, std::uint8_t subindex,
+                     ConstBytes data, bool completeAccess = false);
+  Result<OdList> readOdList(std::size_t position);
+  Result<ObjectDescription> readObjectDescription(std::size_t position, std::uint16_t index);
+  Result<EntryDescription> readEntryDescription(std::size_t position, std::uint16_t index,
+                                                std::uint8_t subindex);
+  Result<std::vector<std::uint8_t>> readRegisters(std::size_t position, std::uint16_t address,
+                                                  std::uint16_t length);
+  Status writeRegisters(std::size_t position, std::uint16_t address, ConstBytes data);
+
+  const std::vector<SlaveInfo>& slaves() const { return slaves_; }
+  const std::vector<SlaveProcessData>& processData() const { return processData_; }
+  const ProcessImageLayout& layout() const { return layout_; }
+  ConstBytes image() const { return image_; }
+  const CyclicStatistics& statistics() const { return cyclic_.statistics(); }
+  const CycleResult& lastCycle() const { return lastCycle_; }
+  const std::vector<StateRefusal>& lastRefusals() const { return refusals_; }
+  const std::vector<ReceivedEmergency>& emergencies() const { return emergencies_; }
+  Transport& transport() { return transport_; }
+  Bus& bus() { return bus_; }
+  const MasterOptions& options() const { return options_; }
+
+ private:
+  Status run(Task& task, SimTime timeout, std::string_view what);
+  Result<SlaveInfo*> slaveAt(std::size_t position);
+  Status sendCycle();
+  CycleResult finishCycle();
+
+  MasterOptions options_;
+  Transport transport_;
+  Bus& bus_;
+  std::optional<MasterConfig> config_;
+  std::vector<SlaveInfo> slaves_;
+  std::vector<SlaveProcessData> processData_;
+  ProcessImageLayout layout_;
+  std::vector<std::uint8_t> image_;
+  CyclicExchange cyclic_;
+  CycleResult lastCycle_;
+  std::vector<StateRefusal> refusals_;
+  std::vector<ReceivedEmergency> emergencies_;
+};
+
+}  // namespace ecsim::master
