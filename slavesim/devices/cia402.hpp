@@ -1,0 +1,149 @@
+// CiA 402 (IEC 61800-7-201) drive profile: object indexes, modes of operation, and the power
+// state machine driven by the controlword (0x6040) and shown in the statusword (0x6041).
+//
+// States and their statusword coding (bits 6, 5, 3, 2, 1, 0 with the masks of the profile):
+//   Not ready to switch on   x0xx 0000      Switch on disabled   x1xx 0000
+//   Ready to switch on       x01x 0001      Switched on          x01x 0011
+//   Operation enabled        x01x 0111      Quick stop active    x00x 0111
+//   Fault reaction active    x0xx 1111      Fault                x0xx 1000
+// Commands (controlword bits 7, 3, 2, 1, 0):
+//   Shutdown 0xxx x110 (transitions 2, 6, 8)       Switch on 0xxx 0111 (3)
+//   Disable voltage 0xxx xx0x (7, 9, 10, 12)       Quick stop 0xxx x01x (7, 10, 11)
+//   Disable operation 0xxx 0111 (5)                Enable operation 0xxx 1111 (4, 16)
+//   Fault reset: rising edge of bit 7 (15); while bit 7 stays set no command is decoded.
+// Transitions 0 and 1 (power-up), 12 (quick stop finished, option codes 0-4), 13 (fault) and
+// 14 (fault reaction finished) are the drive's own; nextState() covers the commanded ones.
+// "Enable operation" in Ready to switch on goes through Switched on to Operation enabled
+// (transitions 3 and 4 in one step), as drives accept the usual 0x06 -> 0x0F sequence.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string_view>
+
+namespace ecsim::slavesim::devices::cia402 {
+
+// ---- objects ----------------------------------------------------------------------------------
+namespace obj {
+inline constexpr std::uint16_t kErrorCode = 0x603F;
+inline constexpr std::uint16_t kControlword = 0x6040;
+inline constexpr std::uint16_t kStatusword = 0x6041;
+inline constexpr std::uint16_t kQuickStopOptionCode = 0x605A;
+inline constexpr std::uint16_t kModesOfOperation = 0x6060;
+inline constexpr std::uint16_t kModesOfOperationDisplay = 0x6061;
+inline constexpr std::uint16_t kPositionActualValue = 0x6064;
+inline constexpr std::uint16_t kFollowingErrorWindow = 0x6065;
+inline constexpr std::uint16_t kFollowingErrorTimeout = 0x6066;
+inline constexpr std::uint16_t kVelocityActualValue = 0x606C;
+inline constexpr std::uint16_t kTargetTorque = 0x6071;
+inline constexpr std::uint16_t kMaxTorque = 0x6072;
+inline constexpr std::uint16_t kTorqueActualValue = 0x6077;
+inline constexpr std::uint16_t kTargetPosition = 0x607A;
+inline constexpr std::uint16_t kSoftwarePositionLimit = 0x607D;  // :01 min, :02 max
+inline constexpr std::uint16_t kMaxMotorSpeed = 0x6080;          // rpm
+inline constexpr std::uint16_t kProfileVelocity = 0x6081;
+inline constexpr std::uint16_t kProfileAcceleration = 0x6083;
+inline constexpr std::uint16_t kProfileDeceleration = 0x6084;
+inline constexpr std::uint16_t kHomingMethod = 0x6098;
+inline constexpr std::uint16_t kHomingSpeeds = 0x6099;  // :01 switch search, :02 zero search
+inline constexpr std::uint16_t kHomingAcceleration = 0x609A;
+inline constexpr std::uint16_t kInterpolationTimePeriod = 0x60C2;  // :01 value, :02 index
+inline constexpr std::uint16_t kFollowingErrorActualValue = 0x60F4;
+inline constexpr std::uint16_t kTargetVelocity = 0x60FF;
+inline constexpr std::uint16_t kSupportedDriveModes = 0x6502;
+}  // namespace obj
+
+// Error codes (0x603F, CiA 402 / CiA 301 emergency codes).
+inline constexpr std::uint16_t kErrorFollowing = 0x8611;      // position following error
+inline constexpr std::uint16_t kErrorCommunication = 0x8100;  // communication, generic
+
+// ---- controlword and statusword bits ------------------------------------------------------------
+namespace cw {
+inline constexpr std::uint16_t kSwitchOn = 1u << 0;
+inline constexpr std::uint16_t kEnableVoltage = 1u << 1;
+inline constexpr std::uint16_t kQuickStop = 1u << 2;  // active low
+inline constexpr std::uint16_t kEnableOperation = 1u << 3;
+inline constexpr std::uint16_t kNewSetPoint = 1u << 4;        // PP; HM: homing operation start
+inline constexpr std::uint16_t kChangeImmediately = 1u << 5;  // PP
+inline constexpr std::uint16_t kRelative = 1u << 6;           // PP
+inline constexpr std::uint16_t kFaultReset = 1u << 7;
+inline constexpr std::uint16_t kHalt = 1u << 8;
+}  // namespace cw
+
+namespace sw {
+inline constexpr std::uint16_t kReadyToSwitchOn = 1u << 0;
+inline constexpr std::uint16_t kSwitchedOn = 1u << 1;
+inline constexpr std::uint16_t kOperationEnabled = 1u << 2;
+inline constexpr std::uint16_t kFault = 1u << 3;
+inline constexpr std::uint16_t kVoltageEnabled = 1u << 4;
+inline constexpr std::uint16_t kQuickStop = 1u << 5;  // 0: quick stop active
+inline constexpr std::uint16_t kSwitchOnDisabled = 1u << 6;
+inline constexpr std::uint16_t kWarning = 1u << 7;
+inline constexpr std::uint16_t kRemote = 1u << 9;
+inline constexpr std::uint16_t kTargetReached = 1u << 10;
+inline constexpr std::uint16_t kInternalLimitActive = 1u << 11;
+inline constexpr std::uint16_t kModeSpecific12 = 1u << 12;  // PP set-point ack, PV speed 0,
+                                                            // HM attained, CSx follows command
+inline constexpr std::uint16_t kModeSpecific13 = 1u << 13;  // PP/CSP following error, HM error
+inline constexpr std::uint16_t kStateMask = 0x006F;
+}  // namespace sw
+
+// ---- modes ------------------------------------------------------------------------------------
+enum class Mode : std::int8_t {
+  kNone = 0,
+  kProfilePosition = 1,
+  kProfileVelocity = 3,
+  kHoming = 6,
+  kCyclicSyncPosition = 8,
+  kCyclicSyncVelocity = 9,
+  kCyclicSyncTorque = 10,
+};
+// The 0x6502 bit of a mode of operation (0 for modes with no bit, e.g. manufacturer modes).
+std::uint32_t supportedModeBit(std::int8_t mode);
+std::string_view toString(Mode mode);
+
+// ---- state machine ----------------------------------------------------------------------------
+enum class State : std::uint8_t {
+  kNotReadyToSwitchOn,
+  kSwitchOnDisabled,
+  kReadyToSwitchOn,
+  kSwitchedOn,
+  kOperationEnabled,
+  kQuickStopActive,
+  kFaultReactionActive,
+  kFault,
+};
+std::string_view toString(State state);
+
+enum class Command : std::uint8_t {
+  kNone,  // bit 7 held high: nothing decoded
+  kShutdown,
+  kSwitchOn,  // also "disable operation" (same coding)
+  kEnableOperation,
+  kDisableVoltage,
+  kQuickStop,
+  kFaultReset,
+};
+std::string_view toString(Command command);
+
+// Decodes a controlword; `previous` is the controlword of the previous cycle (for the edge of
+// the fault-reset bit).
+Command decodeControlword(std::uint16_t controlword, std::uint16_t previous);
+
+// The state a command leads to from `state` (the same state when the command does not apply
+// there). `quickStopOption` is 0x605A: with 5-8 "enable operation" leaves quick stop active.
+State nextState(State state, Command command, int quickStopOption);
+
+// Statusword bits 0-6 and 9 (remote) for a state; bit 4 (voltage enabled) in every state but
+// "not ready to switch on".
+std::uint16_t statusBits(State state);
+// The state a statusword shows (by the masks above); nullopt for a coding no state has.
+std::optional<State> stateFromStatusword(std::uint16_t statusword);
+
+// True in the states where the power stage drives the motor.
+constexpr bool powered(State s) {
+  return s == State::kOperationEnabled || s == State::kQuickStopActive ||
+         s == State::kFaultReactionActive;
+}
+
+}  // namespace ecsim::slavesim::devices::cia402

@@ -1,0 +1,313 @@
+// The CiA 402 drive: construction, time keeping, power state machine, monitoring and the
+// objects it publishes. The modes of operation are in cia402_modes.cpp.
+#include "slavesim/devices/cia402_drive.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "slavesim/devices/device_state.hpp"
+
+namespace ecsim::slavesim::devices {
+
+using cia402::State;
+
+namespace {
+
+// At most this much motor time is simulated in one step (a stalled clock, a debugger): the
+// rest is dropped rather than stalling the firmware.
+constexpr SimTime kMaxCatchUp = 10 * kNsPerSecond;
+constexpr std::uint64_t kFollowingErrorOff = 0xFFFFFFFFu;
+constexpr std::int64_t kDefaultMaxTorquePerMille = 3000;
+
+std::int32_t wrap32(std::int64_t v) {
+  return static_cast<std::int32_t>(static_cast<std::uint32_t>(static_cast<std::uint64_t>(v)));
+}
+
+}  // namespace
+
+Cia402Drive::Cia402Drive(coe::ObjectDictionary& od, const DriveParams& params)
+    : od_(od),
+      params_(params),
+      axis_(params.motor, params.gains.value_or(ServoGains::tuned(params.motor)), params.axis),
+      encoder_(params.encoder) {}
+
+Result<std::unique_ptr<Cia402Drive>> Cia402Drive::create(coe::ObjectDictionary& od,
+                                                         const DriveParams& params) {
+  std::unique_ptr<Cia402Drive> drive(new Cia402Drive(od, params));
+  ECSIM_TRY(drive->init());
+  return drive;
+}
+
+Status Cia402Drive::init() {
+  using namespace cia402::obj;
+  for (std::uint16_t index : {kControlword, kStatusword, kModesOfOperation,
+                              kModesOfOperationDisplay, kPositionActualValue}) {
+    if (od_.findEntry(index, 0) == nullptr) {
+      return makeError(ErrorCode::kNotFound,
+                       "CiA 402 drive: dictionary has no object " + std::to_string(index));
+    }
+  }
+  auto ref = [&](std::uint16_t index, std::uint8_t sub = 0) { return ObjectRef(od_, index, sub); };
+  obj_.errorCode = ref(kErrorCode);
+  obj_.controlword = ref(kControlword);
+  obj_.statusword = ref(kStatusword);
+  obj_.quickStopOption = ref(kQuickStopOptionCode);
+  obj_.mode = ref(kModesOfOperation);
+  obj_.modeDisplay = ref(kModesOfOperationDisplay);
+  obj_.positionActual = ref(kPositionActualValue);
+  obj_.feWindow = ref(kFollowingErrorWindow);
+  obj_.feTimeout = ref(kFollowingErrorTimeout);
+  obj_.velocityActual = ref(kVelocityActualValue);
+  obj_.targetTorque = ref(kTargetTorque);
+  obj_.maxTorque = ref(kMaxTorque);
+  obj_.torqueActual = ref(kTorqueActualValue);
+  obj_.targetPosition = ref(kTargetPosition);
+  obj_.limitMin = ref(kSoftwarePositionLimit, 1);
+  obj_.limitMax = ref(kSoftwarePositionLimit, 2);
+  obj_.maxMotorSpeed = ref(kMaxMotorSpeed);
+  obj_.profileVelocity = ref(kProfileVelocity);
+  obj_.profileAcceleration = ref(kProfileAcceleration);
+  obj_.profileDeceleration = ref(kProfileDeceleration);
+  obj_.homingMethod = ref(kHomingMethod);
+  obj_.homingSpeedSwitch = ref(kHomingSpeeds, 1);
+  obj_.homingSpeedZero = ref(kHomingSpeeds, 2);
+  obj_.homingAcceleration = ref(kHomingAcceleration);
+  obj_.ipValue = ref(kInterpolationTimePeriod, 1);
+  obj_.ipIndex = ref(kInterpolationTimePeriod, 2);
+  obj_.feActual = ref(kFollowingErrorActualValue);
+  obj_.targetVelocity = ref(kTargetVelocity);
+  obj_.supportedModes = ref(kSupportedDriveModes);
+
+  double angle = params_.initialShaftAngle;
+  if (!params_.stateFile.empty()) {
+    auto loaded = loadDeviceState(params_.stateFile);
+    if (loaded.ok()) {
+      angle = loaded->shaftAngle;
+    } else if (loaded.error().code != ErrorCode::kNotFound) {
+      return loaded.takeError();
+    }
+  }
+  axis_.motor().setAngle(angle);
+  encoder_.powerOn(angle);
+  countsToRad_ = 2.0 * std::numbers::pi / encoder_.params().countsPerRevolution;
+  measure();
+  demand_ = measured_;
+  profile_.reset(measured_, 0.0);
+  cspStart_ = cspEnd_ = measured_;
+  publish(0);
+  return okStatus();
+}
+
+Cia402Drive::~Cia402Drive() {
+  (void)saveState();
+}
+
+Status Cia402Drive::saveState() const {
+  if (params_.stateFile.empty()) return okStatus();
+  return saveDeviceState(params_.stateFile, DeviceState{axis_.motor().angle()});
+}
+
+double Cia402Drive::velocity() const {
+  return axis_.motor().velocity() / countsToRad_;
+}
+
+bool Cia402Drive::homeSwitch() const {
+  return params_.homeSwitchCounts &&
+         static_cast<double>(reading_.counts) >= *params_.homeSwitchCounts;
+}
+
+double Cia402Drive::torqueLimitNm() const {
+  const auto perMille = static_cast<double>(obj_.maxTorque.get(kDefaultMaxTorquePerMille));
+  return std::max(0.0, perMille) / 1000.0 * params_.motor.ratedTorque;
+}
+
+double Cia402Drive::velocityLimitCounts() const {
+  const auto rpm = static_cast<double>(obj_.maxMotorSpeed.getUnsigned(0));
+  if (rpm <= 0.0) return std::numeric_limits<double>::infinity();
+  return rpm / 60.0 * encoder_.params().countsPerRevolution;
+}
+
+SimTime Cia402Drive::interpolationPeriod() const {
+  const auto value = static_cast<double>(obj_.ipValue.getUnsigned(1));
+  const auto index = static_cast<double>(obj_.ipIndex.get(-3));
+  if (value <= 0.0 || index < -9.0 || index > 0.0) return kNsPerMs;
+  const auto ns = static_cast<SimTime>(std::llround(value * std::pow(10.0, index + 9.0)));
+  return std::clamp<SimTime>(ns, axis_.substepNs(), kNsPerSecond);
+}
+
+void Cia402Drive::measure() {
+  reading_ = encoder_.read(axis_.motor().angle());
+  measured_ = static_cast<double>(reading_.counts + offset_);
+}
+
+void Cia402Drive::step(coe::ObjectDictionary& /*od*/, AlState al, SimTime now) {
+  if (!started_) {
+    started_ = true;
+    lastNow_ = now;
+    readyAt_ = now + params_.initTime;
+  }
+  const SimTime dt = now > lastNow_ ? now - lastNow_ : 0;
+  lastNow_ = std::max(lastNow_, now);
+  advance(dt);
+  takeCommands(al);
+  publish(now);
+}
+
+void Cia402Drive::advance(SimTime dt) {
+  pendingNs_ = std::min(pendingNs_ + dt, kMaxCatchUp);
+  const SimTime h = axis_.substepNs();
+  while (pendingNs_ >= h) {
+    substep();
+    pendingNs_ -= h;
+    clock_ += h;
+  }
+}
+
+void Cia402Drive::substep() {
+  measure();
+  internalLimit_ = false;
+  ServoCommand command;
+  switch (state_) {
+    case State::kOperationEnabled:
+      command = operate();
+      break;
+    case State::kQuickStopActive:
+      command = stopping(false);
+      break;
+    case State::kFaultReactionActive:
+      command = stopping(true);
+      break;
+    default:
+      break;  // power stage off
+  }
+  positionDemand_ = command.mode == ControlMode::kPosition;
+  checkFollowingError(positionDemand_ && state_ == State::kOperationEnabled);
+  axis_.substep(command, encoder_.angleOf(static_cast<double>(reading_.counts)));
+}
+
+void Cia402Drive::checkFollowingError(bool active) {
+  const std::uint64_t window = obj_.feWindow.getUnsigned(kFollowingErrorOff);
+  if (!active || window == kFollowingErrorOff) {
+    feSince_.reset();
+    warning_ = false;
+    return;
+  }
+  const double error = std::abs(demand_ - measured_);
+  if (error <= static_cast<double>(window)) {
+    feSince_.reset();
+    warning_ = false;
+    return;
+  }
+  warning_ = true;
+  if (!feSince_) feSince_ = clock_;
+  const SimTime timeout = static_cast<SimTime>(obj_.feTimeout.getUnsigned(0)) * kNsPerMs;
+  if (clock_ - *feSince_ >= timeout) {
+    followingError_ = true;
+    raiseFault(cia402::kErrorFollowing);
+  }
+}
+
+void Cia402Drive::takeCommands(AlState al) {
+  if (al != lastAl_) {
+    lastAl_ = al;
+    (void)saveState();
+  }
+  if (state_ == State::kNotReadyToSwitchOn && lastNow_ >= readyAt_) {
+    enterState(State::kSwitchOnDisabled);  // transition 1
+  }
+  // The mode is a setting: it may be chosen by SDO before OP.
+  const auto requested = static_cast<std::int8_t>(obj_.mode.get(mode_));
+  if (requested != mode_) switchMode(requested);
+  if (al != AlState::kOp) {
+    // No valid outputs: commands are not taken; a running power stage is a fault.
+    if (cia402::powered(state_) && state_ != State::kFaultReactionActive) {
+      raiseFault(cia402::kErrorCommunication);
+    }
+    return;
+  }
+  const std::uint16_t previous = previousControlword_;
+  const std::uint16_t controlword =
+      effectiveControlword(static_cast<std::uint16_t>(obj_.controlword.getUnsigned()));
+  previousControlword_ = controlword;
+  const cia402::Command command = cia402::decodeControlword(controlword, previous);
+  const int option = static_cast<int>(obj_.quickStopOption.get(2));
+  const State next = cia402::nextState(state_, command, option);
+  if (next != state_) enterState(next);
+  latchModeInputs(controlword, previous);
+}
+
+void Cia402Drive::enterState(State next) {
+  const State previous = state_;
+  state_ = next;
+  switch (next) {
+    case State::kOperationEnabled:
+      if (previous != State::kQuickStopActive) axis_.resetControllers();
+      holding_ = false;
+      startMode();
+      break;
+    case State::kQuickStopActive: {
+      const int option = static_cast<int>(obj_.quickStopOption.get(2));
+      if (option == 0) {
+        state_ = State::kSwitchOnDisabled;  // disable drive function, then transition 12
+        break;
+      }
+      profile_.reset(measured_, velocity());
+      demand_ = measured_;
+      holding_ = false;
+      break;
+    }
+    case State::kFaultReactionActive:
+      faultReactionStart_ = clock_;
+      profile_.reset(measured_, velocity());
+      holding_ = false;
+      break;
+    case State::kSwitchOnDisabled:
+      if (previous == State::kFault) {
+        errorCode_ = 0;  // transition 15: fault reset
+        followingError_ = false;
+      }
+      break;
+    default:
+      break;
+  }
+  if (cia402::powered(previous) && !cia402::powered(state_)) (void)saveState();
+}
+
+void Cia402Drive::raiseFault(std::uint16_t code) {
+  if (state_ == State::kFault || state_ == State::kFaultReactionActive) return;
+  errorCode_ = code;
+  enterState(cia402::powered(state_) ? State::kFaultReactionActive : State::kFault);
+}
+
+void Cia402Drive::injectFault(std::uint16_t code) {
+  raiseFault(code);
+}
+
+void Cia402Drive::switchMode(std::int8_t requested) {
+  constexpr std::uint32_t kImplemented = 0x3A5;  // PP, PV, HM, CSP, CSV, CST
+  const std::uint32_t supported =
+      static_cast<std::uint32_t>(obj_.supportedModes.getUnsigned(kImplemented)) & kImplemented;
+  if ((cia402::supportedModeBit(requested) & supported) == 0) return;  // refused: keep the mode
+  mode_ = requested;
+  startMode();
+}
+
+void Cia402Drive::publish(SimTime now) {
+  std::uint16_t status = cia402::statusBits(state_);
+  if (warning_) status |= cia402::sw::kWarning;
+  if (internalLimit_) status |= cia402::sw::kInternalLimitActive;
+  status |= modeStatusBits();
+  statusword_ = status;
+  obj_.statusword.set(status);
+  obj_.modeDisplay.set(mode_);
+  obj_.positionActual.set(wrap32(reading_.reported + offset_));
+  obj_.velocityActual.set(std::llround(velocity()));
+  obj_.torqueActual.set(std::llround(axis_.torque() / params_.motor.ratedTorque * 1000.0));
+  obj_.feActual.set(positionDemand_ ? std::llround(demand_ - measured_) : 0);
+  obj_.errorCode.set(errorCode_);
+  publishExtra(now);
+}
+
+}  // namespace ecsim::slavesim::devices

@@ -1,0 +1,211 @@
+// A CiA 402 servo drive (the ECS7201 of examples/esi/ecsim_devices.xml, and the base of the
+// ECS7211): an Application of the slave's ProcessDataDevice that works on the CiA 402 objects
+// of its dictionary, so a master reaches it through PDOs and SDOs exactly as a real drive.
+//
+// Each step(now) first advances the motor by the time elapsed since the previous step (in
+// substeps of the servo axis, 62.5 us at 16 kHz) under the commands taken at the previous
+// step, then takes the new outputs (controlword, mode, targets), runs the power state machine
+// and writes the inputs (statusword, actual values). So outputs a frame brings at time t act
+// from t on, and the inputs show the drive at `now`.
+//
+// Behaviour, in the terms of cia402.hpp:
+//  - the controlword is obeyed in OP only. Leaving OP while the power stage is on is a
+//    communication fault (0x8100): fault reaction, then Fault. Not ready to switch on lasts
+//    DriveParams::initTime after the first step.
+//  - modes (0x6060, shown in 0x6061 once active; a mode 0x6502 does not list is refused and
+//    the previous one stays): CSP (target position interpolated linearly over the 0x60C2
+//    period, its slope as velocity feed-forward), CSV, CST (0x6071 per mille of rated torque),
+//    PP (bit 4 new set-point with acknowledge in bit 12, bit 5 change immediately, bit 6
+//    relative, one buffered set-point, 0x6081/0x6083/0x6084), PV (0x60FF ramped with
+//    0x6083/0x6084), HM (bit 4 starts; methods 37 and 35: the present position is home;
+//    19 and 20: home switch, see DriveParams::homeSwitchCounts). Bit 8 halts PP, PV and HM.
+//  - limits: 0x6072 max torque (per mille), 0x6080 max motor speed (rpm, 0: none), 0x607D
+//    software position limits (position modes clamp their demand; velocity and torque modes
+//    stop pushing outwards) with bit 11 while one acts.
+//  - following error (position modes): 0x60F4 = demand - actual; beyond 0x6065 the warning
+//    bit 7 is set, beyond it for longer than 0x6066 ms bit 13 and fault 0x8611 in 0x603F
+//    (0x6065 = 0xFFFFFFFF switches monitoring off).
+//  - quick stop (0x605A): 0 coast; 1/5 profile deceleration, 2/6 quick-stop deceleration,
+//    3/7 and 4/8 at the torque limit; 1-4 then Switch on disabled, 5-8 hold in Quick stop
+//    active. The fault reaction stops at the quick-stop deceleration (at most
+//    faultReactionTimeout), then the power stage goes off.
+//  - transitions 5, 8 and 9 switch the power stage off at once (the motor coasts).
+//  - position is the encoder count plus the home offset; 0x6064 wraps at 32 bits. The shaft
+//    angle is kept in DriveParams::stateFile (read at creation; written when the power stage
+//    goes off, on AL state changes, by saveState() and when the drive is destroyed).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+
+#include "protocol/result.hpp"
+#include "slavesim/devices/cia402.hpp"
+#include "slavesim/devices/encoder.hpp"
+#include "slavesim/devices/motion_profile.hpp"
+#include "slavesim/devices/object_ref.hpp"
+#include "slavesim/devices/servo_axis.hpp"
+#include "slavesim/process_data.hpp"
+
+namespace ecsim::slavesim::devices {
+
+struct DriveParams {
+  MotorParams motor;
+  std::optional<ServoGains> gains;  // default: ServoGains::tuned(motor)
+  AxisOptions axis;
+  EncoderParams encoder;
+  double quickStopDeceleration{2.0e7};  // counts/s^2 (about 150 rev/s^2 at 17 bits)
+  double positionWindow{100.0};         // counts: PP target reached
+  double velocityWindow{2000.0};        // counts/s: PV target reached
+  double velocityThreshold{500.0};      // counts/s: "speed = 0", stop detection
+  std::int64_t homeOffset{0};           // counts: the position the home point gets
+  // Home switch: active while the encoder count (before any home offset) is >= this.
+  std::optional<double> homeSwitchCounts{0.0};
+  SimTime initTime{0};                           // in Not ready to switch on
+  SimTime faultReactionTimeout{500 * kNsPerMs};  // longest fault reaction
+  double initialShaftAngle{0.0};                 // rad, when there is no state file yet
+  std::filesystem::path stateFile;               // empty: nothing kept
+};
+
+class Cia402Drive : public Application {
+ public:
+  // Needs 0x6040, 0x6041, 0x6060, 0x6061 and 0x6064 in the dictionary; the other objects are
+  // used when present. Fails when the state file exists but cannot be read.
+  static Result<std::unique_ptr<Cia402Drive>> create(coe::ObjectDictionary& od,
+                                                     const DriveParams& params = {});
+  ~Cia402Drive() override;
+
+  void step(coe::ObjectDictionary& od, AlState state, SimTime now) override;
+
+  cia402::State state() const { return state_; }
+  std::int8_t activeMode() const { return mode_; }
+  std::uint16_t statusword() const { return statusword_; }
+  std::uint16_t errorCode() const { return errorCode_; }
+  // Unwrapped position (counts, with home offset) as the drive measures it, and its demand.
+  double position() const { return measured_; }
+  double demandPosition() const { return demand_; }
+  double velocity() const;  // counts/s
+  bool homeSwitch() const;
+  bool homingAttained() const { return homingAttained_; }
+
+  ServoAxis& axis() { return axis_; }
+  Encoder& encoder() { return encoder_; }
+  const DriveParams& params() const { return params_; }
+  // Raises a fault from outside (fault injection): fault reaction, then Fault with `code`.
+  void injectFault(std::uint16_t code);
+  // Writes the state file now (no-op without one).
+  Status saveState() const;
+
+ protected:
+  Cia402Drive(coe::ObjectDictionary& od, const DriveParams& params);
+  Status init();
+  // Hooks for derived drives: the controlword the state machine gets (default: the master's),
+  // and the inputs to publish after each step.
+  virtual std::uint16_t effectiveControlword(std::uint16_t fromMaster) { return fromMaster; }
+  virtual void publishExtra(SimTime /*now*/) {}
+  bool internalLimit() const { return internalLimit_; }
+  std::int64_t encoderReported() const { return reading_.reported; }
+  AlState alState() const { return lastAl_; }
+
+ private:
+  enum class HomingPhase : std::uint8_t {
+    kIdle,
+    kSearchSwitch,  // fast, towards the switch
+    kLeaveSwitch,   // fast, out of the switch
+    kSearchEdge,    // slow, until the edge
+    kStopping,      // home found, braking
+    kDone,
+    kError,
+  };
+
+  // ---- cia402_drive.cpp ----
+  void advance(SimTime dt);
+  void substep();
+  void measure();
+  void takeCommands(AlState al);
+  void enterState(cia402::State next);
+  void raiseFault(std::uint16_t code);
+  void switchMode(std::int8_t requested);
+  void publish(SimTime now);
+  void checkFollowingError(bool positionControlled);
+  double torqueLimitNm() const;
+  double velocityLimitCounts() const;
+  SimTime interpolationPeriod() const;
+  // ---- cia402_modes.cpp ----
+  void startMode();
+  void latchModeInputs(std::uint16_t controlword, std::uint16_t previous);
+  // The servo command for this substep in Operation enabled.
+  ServoCommand operate();
+  ServoCommand stopping(bool faultReaction);
+  ServoCommand positionCommand(double position, double velocity);
+  ServoCommand velocityCommand(double velocity);
+  void startPpSetPoint(std::uint16_t controlword);
+  void startHoming();
+  void homingSubstep(double dt);
+  void setHome();
+  std::uint16_t modeStatusBits() const;
+  double clampToLimits(double position);
+  // +1 at or beyond the upper software limit, -1 at or below the lower one, else 0.
+  int limitSide() const;
+
+  coe::ObjectDictionary& od_;
+  DriveParams params_;
+  ServoAxis axis_;
+  Encoder encoder_;
+  struct Objects {
+    ObjectRef errorCode, controlword, statusword, quickStopOption, mode, modeDisplay;
+    ObjectRef positionActual, feWindow, feTimeout, velocityActual, targetTorque, maxTorque;
+    ObjectRef torqueActual, targetPosition, limitMin, limitMax, maxMotorSpeed;
+    ObjectRef profileVelocity, profileAcceleration, profileDeceleration;
+    ObjectRef homingMethod, homingSpeedSwitch, homingSpeedZero, homingAcceleration;
+    ObjectRef ipValue, ipIndex, feActual, targetVelocity, supportedModes;
+  } obj_;
+
+  cia402::State state_{cia402::State::kNotReadyToSwitchOn};
+  std::int8_t mode_{0};
+  std::uint16_t previousControlword_{0};
+  std::uint16_t statusword_{0};
+  std::uint16_t errorCode_{0};
+  bool started_{false};
+  SimTime lastNow_{0};
+  SimTime pendingNs_{0};
+  SimTime clock_{0};  // time of the motor model (the start of the next substep)
+  SimTime readyAt_{0};
+  AlState lastAl_{AlState::kInit};
+
+  EncoderReading reading_{};
+  std::int64_t offset_{0};  // drive position = encoder count + offset_
+  double measured_{0.0};    // drive position, counts, unwrapped
+  double demand_{0.0};      // position demand, counts, unwrapped (position modes)
+  bool positionDemand_{false};
+  bool internalLimit_{false};
+  bool warning_{false};
+  bool followingError_{false};
+  std::optional<SimTime> feSince_;
+  double countsToRad_{0.0};
+
+  // mode state
+  MotionProfile profile_;
+  double cspStart_{0.0}, cspEnd_{0.0};
+  SimTime cspElapsed_{0}, cspPeriod_{kNsPerMs};
+  std::int32_t cspLastRaw_{0};
+  double velocityTarget_{0.0};  // CSV/PV, counts/s
+  double torqueTarget_{0.0};    // CST, N m
+  bool halt_{false};
+  // PP
+  double ppTarget_{0.0};
+  bool ppMoving_{false};
+  std::optional<double> ppBuffered_;
+  bool ppAck_{false};
+  bool ppReached_{true};
+  // HM
+  HomingPhase homing_{HomingPhase::kIdle};
+  bool homingAttained_{false};
+  int homingMethod_{0};
+  // stopping (quick stop, fault reaction)
+  bool holding_{false};
+  SimTime faultReactionStart_{0};
+};
+
+}  // namespace ecsim::slavesim::devices

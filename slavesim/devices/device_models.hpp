@@ -1,0 +1,61 @@
+// Which device model a slave gets, and the way to reach it afterwards. The models are
+// Applications of the slave's ProcessDataDevice (process_data.hpp), so the dictionary, the PDO
+// binding and the CoE server stay as they are; the model only fills the inputs and reacts to
+// the outputs.
+//
+//   ECS1008 (0x1008)            DigitalInputTerminal over 0x6000:01-08
+//   ECS2008 (0x2008)            DigitalOutputTerminal over 0x7000:01-08
+//   ECS3102 (0x3102)            AnalogInputTerminal, 2 channels
+//   ECS7201 (0x7201)            Cia402Drive
+//   ECS7211 (0x7211)            RobotDrive
+// for the ecsim vendor id (0x00000E5C); an ecsim device with CiA 402 profile (ProfileNo 402)
+// and another product code also gets a Cia402Drive. Devices of other vendors keep the plain
+// ProcessDataDevice: their dictionaries are theirs to define.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+
+#include "protocol/result.hpp"
+#include "slavesim/devices/cia402_drive.hpp"
+#include "slavesim/devices/io_terminals.hpp"
+#include "slavesim/devices/robot_drive.hpp"
+#include "slavesim/process_data.hpp"
+#include "slavesim/slave.hpp"
+
+namespace ecsim::slavesim::devices {
+
+enum class DeviceModelKind : std::uint8_t {
+  kNone,
+  kDigitalInputs,
+  kDigitalOutputs,
+  kAnalogInputs,
+  kCia402Drive,
+  kRobotDrive,
+};
+
+DeviceModelKind deviceModelFor(std::uint32_t vendorId, std::uint32_t productCode,
+                               std::optional<std::uint32_t> profileNo = std::nullopt);
+
+struct DeviceModelOptions {
+  std::filesystem::path stateFile;  // drives: where the shaft position is kept
+  DriveParams drive;                // drives: motor, loops, encoder (stateFile above wins)
+  AnalogInputOptions analog;
+};
+
+// Attaches the model to `device` (kNone: removes any). A previous model is destroyed first, so
+// a drive saves its state file before its successor reads it (a simulated power cycle).
+// Drives take the encoder resolution from 0x2011 when the dictionary has it.
+Status attachDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,
+                         const DeviceModelOptions& options = {});
+
+// The model of a slave built by makeSlaveFromEsi (nullptr when it has another or none).
+Application* deviceModelOf(Slave& slave);
+Cia402Drive* driveOf(Slave& slave);  // also a RobotDrive
+RobotDrive* robotDriveOf(Slave& slave);
+DigitalInputTerminal* digitalInputsOf(Slave& slave);
+DigitalOutputTerminal* digitalOutputsOf(Slave& slave);
+AnalogInputTerminal* analogInputsOf(Slave& slave);
+
+}  // namespace ecsim::slavesim::devices

@@ -1,0 +1,76 @@
+// Scripted input signals for simulated IO terminals: a value as a function of simulation time.
+// A Signal is a plain value (constant, square, sine, ramp or a table read from a CSV file);
+// value(t) is pure and never allocates, so terminals evaluate it on the cyclic path.
+//
+// Text form (parseSignal), for topology files and command lines:
+//   "1.5"                                    constant
+//   "constant value=1.5"
+//   "square period=0.5 low=0 high=1 duty=0.5 phase=0"
+//   "sine amplitude=5 frequency=2 offset=0 phase=0"          (phase in seconds, like square)
+//   "ramp start=0 slope=1 min=-10 max=10 period=0"           (period > 0: sawtooth)
+//   "csv file=path/to/trace.csv loop=0 step=0"
+// Times are seconds of simulation time. A CSV file has one "time,value" row per line (seconds,
+// ascending; blank lines, '#' comments and a non-numeric header line are skipped); values are
+// interpolated linearly (step=1: held until the next row), held after the last row or repeated
+// (loop=1, period = last time).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "protocol/result.hpp"
+#include "protocol/time.hpp"
+
+namespace ecsim::slavesim::devices {
+
+class Signal {
+ public:
+  enum class Kind : std::uint8_t { kConstant, kSquare, kSine, kRamp, kTable };
+  struct Point {
+    double time{0.0};  // seconds
+    double value{0.0};
+  };
+
+  Signal() = default;
+  static Signal constant(double value);
+  // `high` for the first `duty` fraction of each period, `low` for the rest; periods start at
+  // t = phase (seconds).
+  static Signal square(double period, double low, double high, double duty = 0.5,
+                       double phase = 0.0);
+  // offset + amplitude * sin(2 pi f (t - phase)).
+  static Signal sine(double amplitude, double frequencyHz, double offset = 0.0, double phase = 0.0);
+  // start + slope * t, clamped to [min, max]; with period > 0 it restarts every period.
+  static Signal ramp(double start, double slope, double min = -1e300, double max = 1e300,
+                     double period = 0.0);
+  // Points must be ascending in time (checked by fromCsv; here the caller's duty).
+  static Signal table(std::vector<Point> points, bool loop = false, bool step = false);
+  // Reads a "time,value" CSV file; errors name the file and line.
+  static Result<Signal> fromCsv(const std::filesystem::path& path, bool loop = false,
+                                bool step = false);
+
+  Kind kind() const { return kind_; }
+  // The value at simulation time t.
+  double value(SimTime t) const;
+  const std::vector<Point>& points() const { return points_; }
+
+ private:
+  double tableValue(double seconds) const;
+
+  Kind kind_{Kind::kConstant};
+  double a_{0.0};  // constant: value; square: low; sine: amplitude; ramp: start
+  double b_{0.0};  // square: high; sine: frequency; ramp: slope
+  double c_{0.0};  // square: duty; sine: offset; ramp: min
+  double d_{0.0};  // square/sine: phase; ramp: max
+  double period_{0.0};
+  bool loop_{false};
+  bool step_{false};
+  std::vector<Point> points_;
+};
+
+// Parses the text form above. Relative CSV paths are resolved against `baseDir`.
+Result<Signal> parseSignal(std::string_view text, const std::filesystem::path& baseDir = {});
+
+}  // namespace ecsim::slavesim::devices
