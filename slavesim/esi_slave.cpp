@@ -5,6 +5,7 @@
 #include "config/sii_builder.hpp"
 #include "slavesim/coe/od_from_esi.hpp"
 #include "slavesim/coe/standard_objects.hpp"
+#include "slavesim/devices/device_models.hpp"
 
 namespace ecsim::slavesim {
 namespace {
@@ -68,6 +69,14 @@ Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiDevice& device, std::st
   }
   pd->setVirtualSyncManagers(virtualSms);
   pd->updateProfile(profile);
+  if (options.deviceModels) {
+    devices::DeviceModelOptions modelOptions;
+    modelOptions.stateFile = options.stateFile;
+    ECSIM_TRY(devices::attachDeviceModel(
+        *pd,
+        devices::deviceModelFor(sii.identity.vendorId, sii.identity.productCode, device.profileNo),
+        modelOptions));
+  }
 
   auto slave =
       std::make_unique<Slave>(std::move(name), options.escType.value_or(chooseEscType(device)),

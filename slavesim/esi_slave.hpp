@@ -8,11 +8,14 @@
 //              from the ESI <CoE> element); other protocols (and CoE, when the ESI mailbox
 //              has none) get "unsupported protocol" mailbox error replies;
 //   device     ProcessDataDevice over the same dictionary (also for SII-only slaves, whose
-//              dictionary no mailbox reaches); ESI Virtual SMs are neither checked nor copied.
+//              dictionary no mailbox reaches); ESI Virtual SMs are neither checked nor copied;
+//              ecsim's own devices get their model (IO terminal, CiA 402 drive) as its
+//              application, see devices/device_models.hpp.
 // Bootstrap (BOOT state) and modules/slots are not modelled.
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -34,6 +37,10 @@ struct EsiSlaveOptions {
   std::optional<EscType> escType;
   // SII string 1 (SOEM's slave name): the ESI <Name> when true, the <Type> text otherwise.
   bool deviceNameFirst{true};
+  // Attach the device model devices::deviceModelFor() names (false: plain process data).
+  bool deviceModels{true};
+  // Persistent device state (a drive's shaft position), TopologySlave::stateFile.
+  std::filesystem::path stateFile;
 };
 
 // ET1100 by default. A LAN9252-class ESC (4 SMs, 3 FMMUs, 2 ports, 4 KB process RAM) when
