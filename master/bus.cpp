@@ -55,7 +55,7 @@ Status runTask(Task& task, Transport& transport, Bus& bus, SimTime timeout, std:
     const SimTime now = bus.now();
     transport.poll(now);
     const bool running = task.step(now);
-    transport.poll(now);  // send what the step queued
+    transport.flush(now);  // send what the step queued; answers wait for the next poll
     if (!running) return okStatus();
     if (now >= deadline) {
       return makeError(ErrorCode::kTimeout, std::string(what) + ": not finished after " +

@@ -128,6 +128,10 @@ class Transport {
 
   // Receives every waiting frame, handles timeouts and retries, sends queued datagrams.
   void poll(SimTime now);
+  // Sends queued datagrams only (receives nothing): after a step queued new datagrams, so an
+  // answer that arrives meanwhile stays on the link for the next poll() (and wakes a wait on
+  // the link's file descriptor).
+  void flush(SimTime now) { sendQueued(now); }
 
   // Nothing queued and nothing in flight.
   bool idle() const { return queueHead_ == nullptr && inFlight_ == 0; }

@@ -294,5 +294,68 @@ TEST_F(ManualPeerTest, CachedFrameGetsAFreshIndexEachTimeAndIsNeverRetried) {
   EXPECT_TRUE(transport.idle());
 }
 
+// A peer that answers inside send(): the answer is already waiting on the link (its eventfd
+// readable) before the master's loop gets to wait.
+class InstantPeerLink final : public Link {
+ public:
+  InstantPeerLink() : links_(MemoryLink::makePair()) {}
+  Status send(ConstBytes frame) override {
+    ECSIM_TRY(links_.first.send(frame));
+    std::array<std::uint8_t, kMaxFrameSize> buffer{};
+    auto n = links_.second.receive(buffer, std::chrono::nanoseconds(0));
+    if (!n.ok() || *n == 0) return okStatus();
+    auto parsed = EtherCatFrame::parse(Bytes(buffer.data(), *n));
+    if (parsed.ok()) {
+      for (auto d : *parsed) d.setWkc(1);
+    }
+    return links_.second.send(ConstBytes(buffer.data(), *n));
+  }
+  Result<std::size_t> receive(Bytes buffer, std::chrono::nanoseconds timeout) override {
+    return links_.first.receive(buffer, timeout);
+  }
+  int pollFd() const override { return links_.first.pollFd(); }
+  std::string describe() const override { return "instant peer"; }
+
+ private:
+  std::pair<MemoryLink, MemoryLink> links_;
+};
+
+TEST(RunTaskTest, RealTimeLoopDoesNotSleepOnAnAnswerAlreadyReceived) {
+  InstantPeerLink link;
+  RealClock clock;
+  master::RealTimeBus bus(link, clock);
+  Transport transport(link);
+  std::deque<Datagram> datagrams(20);
+  std::size_t next = 0;
+  // Each answered datagram makes the task queue the next one.
+  class Chain final : public master::Task {
+   public:
+    Chain(Transport& t, std::deque<Datagram>& d, std::size_t& n) : t_(t), d_(d), n_(n) {}
+    bool step(SimTime) override {
+      if (n_ > 0 && d_[n_ - 1].pending()) return true;
+      if (n_ == d_.size()) return false;
+      d_[n_].prepare(Command::kBrd, 0, 2, 1);
+      t_.queue(d_[n_++]);
+      return true;
+    }
+
+   private:
+    Transport& t_;
+    std::deque<Datagram>& d_;
+    std::size_t& n_;
+  } chain(transport, datagrams, next);
+  // The first one is queued before the loop starts (as ScanTask::start() does): the loop's
+  // first poll sends it, and its answer is back before the loop gets to wait.
+  datagrams[0].prepare(Command::kBrd, 0, 2, 1);
+  transport.queue(datagrams[0]);
+  next = 1;
+  const SimTime start = clock.now();
+  ASSERT_TRUE(master::runTask(chain, transport, bus, 20 * kNsPerSecond).ok());
+  // 20 round trips through memory: far below one second (a wait until the task deadline
+  // after each answer would take 20 x 20 s).
+  EXPECT_LT(clock.now() - start, kNsPerSecond);
+  for (auto& d : datagrams) EXPECT_TRUE(d.check().ok());
+}
+
 }  // namespace
 }  // namespace ecsim::testing
