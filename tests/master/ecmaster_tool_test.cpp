@@ -1,0 +1,142 @@
+// `ecmaster` as a user runs it, against its in-process simulator (--sim): exit codes, what it
+// prints, its JSON.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "link/netns.hpp"
+
+namespace ecsim::testing {
+namespace {
+
+const std::string kEcmaster = std::string(ECSIM_BINARY_DIR) + "/tools/ecmaster/ecmaster";
+const std::string kDemo = std::string(ECSIM_SOURCE_DIR) + "/examples/topologies/demo.xml";
+
+CommandOutput run(std::vector<std::string> args) {
+  args.insert(args.begin(), kEcmaster);
+  auto out = runCommand(args);
+  EXPECT_TRUE(out.ok());
+  return out.ok() ? *out : CommandOutput{-1, ""};
+}
+
+nlohmann::json json(const CommandOutput& out) {
+  auto j = nlohmann::json::parse(out.output, nullptr, false);
+  EXPECT_FALSE(j.is_discarded()) << out.output;
+  return j;
+}
+
+TEST(EcmasterTool, SlavesListsTheDemoNetwork) {
+  auto out = run({"--sim", kDemo, "slaves"});
+  ASSERT_EQ(out.exitCode, 0) << out.output;
+  EXPECT_NE(out.output.find("  0  0x1001  INIT         vendor 0x00000e5c product 0x00001100 "
+                            "rev 0x00010000  ECS1100"),
+            std::string::npos)
+      << out.output;
+  EXPECT_NE(out.output.find("  5  0x1006  INIT"), std::string::npos) << out.output;
+  auto j = json(run({"--sim", kDemo, "--json", "slaves"}));
+  ASSERT_TRUE(j.is_array());
+  ASSERT_EQ(j.size(), 6u);
+  EXPECT_EQ(j[3]["productCode"], 0x3102);
+  EXPECT_EQ(j[3]["station"], 0x1004);
+  EXPECT_EQ(j[3]["mailboxProtocols"], 0x0004);
+}
+
+TEST(EcmasterTool, StatesGoesToOpAndReportsEverySlave) {
+  auto j = json(run({"--sim", kDemo, "--json", "states", "op"}));
+  EXPECT_EQ(j["ok"], true);
+  ASSERT_EQ(j["slaves"].size(), 6u);
+  for (const auto& s : j["slaves"]) EXPECT_EQ(s["state"], "OP");
+  auto bad = run({"--sim", kDemo, "states", "RUNNING"});
+  EXPECT_EQ(bad.exitCode, 1);
+  EXPECT_NE(bad.output.find("unknown state 'RUNNING'"), std::string::npos) << bad.output;
+}
+
+TEST(EcmasterTool, UploadAndDownloadWithTypes) {
+  auto out = run({"--sim", kDemo, "upload", "-p", "4", "0x1018:02", "--type", "uint32"});
+  ASSERT_EQ(out.exitCode, 0) << out.output;
+  EXPECT_EQ(out.output, "0x00007201 29185\n");
+  out = run({"--sim", kDemo, "upload", "-p", "3", "0x1008:00", "--type", "string"});
+  EXPECT_EQ(out.output, "ECS3102\n");
+  auto j = json(
+      run({"--sim", kDemo, "--json", "download", "-p", "3", "0x8000:13", "250", "-t", "uint16"}));
+  EXPECT_EQ(j["written"], "fa 00");
+  auto abort = run({"--sim", kDemo, "upload", "-p", "3", "0x5555:00"});
+  EXPECT_EQ(abort.exitCode, 1);
+  EXPECT_NE(abort.output.find("abort 0x06020000"), std::string::npos) << abort.output;
+  auto noMailbox = run({"--sim", kDemo, "upload", "-p", "1", "0x1000:00"});
+  EXPECT_EQ(noMailbox.exitCode, 1);
+  EXPECT_NE(noMailbox.output.find("has no mailbox"), std::string::npos) << noMailbox.output;
+}
+
+TEST(EcmasterTool, PdosShowsMappingAndImage) {
+  auto out = run({"--sim", kDemo, "pdos"});
+  ASSERT_EQ(out.exitCode, 0) << out.output;
+  EXPECT_NE(out.output.find("0x6041:00  16 bit \"Statusword\""), std::string::npos) << out.output;
+  EXPECT_NE(out.output.find("process image: 27 output bytes, 39 input bytes"), std::string::npos)
+      << out.output;
+  auto j = json(run({"--sim", kDemo, "--json", "pdos", "-p", "3"}));
+  EXPECT_EQ(j["inputBytes"], 39);
+  ASSERT_EQ(j["slaves"].size(), 1u);
+  EXPECT_EQ(j["slaves"][0]["source"], "CoE");
+}
+
+TEST(EcmasterTool, CyclicRunsWithoutErrorsAndPrintsStatistics) {
+  auto j =
+      json(run({"--sim", kDemo, "--json", "cyclic", "--cycle-us", "1000", "--seconds", "0.5"}));
+  EXPECT_EQ(j["cycles"], 500);
+  EXPECT_EQ(j["wkcErrors"], 0);
+  EXPECT_EQ(j["framesLost"], 0);
+  EXPECT_EQ(j["failedCycles"], 0);
+  EXPECT_GT(j["roundTripUs"]["min"].get<double>(), 0.0);
+  EXPECT_LE(j["roundTripUs"]["min"].get<double>(), j["roundTripUs"]["max"].get<double>());
+  auto text = run({"--sim-slaves", "3", "cyclic", "--seconds", "0.1"});
+  ASSERT_EQ(text.exitCode, 0) << text.output;
+  EXPECT_NE(text.output.find("round trip us: min"), std::string::npos) << text.output;
+  EXPECT_NE(text.output.find("lost frames 0, late frames 0, WKC errors 0"), std::string::npos)
+      << text.output;
+}
+
+TEST(EcmasterTool, RegistersSiiAndDictionary) {
+  auto out = run({"--sim", kDemo, "reg", "read", "-p", "1", "0x130", "--type", "uint16"});
+  ASSERT_EQ(out.exitCode, 0) << out.output;
+  EXPECT_EQ(out.output, "0x0001 1  (AL Status)\n");
+  auto sii = run({"--sim", kDemo, "sii", "-p", "1"});
+  EXPECT_NE(sii.output.find("vendor 0x00000e5c product 0x00001008"), std::string::npos)
+      << sii.output;
+  EXPECT_NE(sii.output.find("TxPDO 0x1a00"), std::string::npos) << sii.output;
+  auto sdos = run({"--sim", kDemo, "sdos", "-p", "3"});
+  ASSERT_EQ(sdos.exitCode, 0) << sdos.output;
+  EXPECT_NE(sdos.output.find("0x1018 RECORD \"Identity\""), std::string::npos) << sdos.output;
+}
+
+TEST(EcmasterTool, IdentityCheckAgainstAConfigFile) {
+  const std::string config = ::testing::TempDir() + "ecmaster_bus.xml";
+  {
+    std::FILE* f = std::fopen(config.c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    std::fputs(
+        "<EcsimMaster>\n"
+        "  <Slave name=\"S1\" vendor=\"#x00000E5C\" product=\"#x00010001\"/>\n"
+        "  <Slave name=\"S2\" vendor=\"#x00000E5C\" product=\"#x00099999\"/>\n"
+        "</EcsimMaster>\n",
+        f);
+    std::fclose(f);
+  }
+  auto out = run({"--sim-slaves", "2", "--config", config, "slaves"});
+  EXPECT_EQ(out.exitCode, 1);
+  EXPECT_NE(out.output.find("slave 1 (0x1002 'Slave2') configured as 'S2'"), std::string::npos)
+      << out.output;
+  EXPECT_NE(out.output.find("product code 0x00010001 (expected 0x00099999)"), std::string::npos)
+      << out.output;
+}
+
+TEST(EcmasterTool, UsageErrors) {
+  auto none = run({"slaves"});
+  EXPECT_EQ(none.exitCode, 1);
+  EXPECT_NE(none.output.find("give either --iface"), std::string::npos) << none.output;
+  auto noSuchIface = run({"--iface", "nosuchif0", "slaves"});
+  EXPECT_EQ(noSuchIface.exitCode, 1);
+}
+
+}  // namespace
+}  // namespace ecsim::testing
