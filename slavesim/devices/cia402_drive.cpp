@@ -166,7 +166,7 @@ void Cia402Drive::advance(SimTime dt) {
 }
 
 void Cia402Drive::substep() {
-  measure();
+  // reading_ was taken at the end of the previous substep (or at creation): now.
   internalLimit_ = false;
   ServoCommand command;
   switch (state_) {
@@ -183,8 +183,10 @@ void Cia402Drive::substep() {
       break;  // power stage off
   }
   positionDemand_ = command.mode == ControlMode::kPosition;
+  followingErrorValue_ = positionDemand_ ? demand_ - measured_ : 0.0;  // both at this instant
   checkFollowingError(positionDemand_ && state_ == State::kOperationEnabled);
   axis_.substep(command, encoder_.angleOf(static_cast<double>(reading_.counts)));
+  measure();
 }
 
 void Cia402Drive::checkFollowingError(bool active) {
@@ -194,7 +196,7 @@ void Cia402Drive::checkFollowingError(bool active) {
     warning_ = false;
     return;
   }
-  const double error = std::abs(demand_ - measured_);
+  const double error = std::abs(followingErrorValue_);
   if (error <= static_cast<double>(window)) {
     feSince_.reset();
     warning_ = false;
@@ -305,7 +307,7 @@ void Cia402Drive::publish(SimTime now) {
   obj_.positionActual.set(wrap32(reading_.reported + offset_));
   obj_.velocityActual.set(std::llround(velocity()));
   obj_.torqueActual.set(std::llround(axis_.torque() / params_.motor.ratedTorque * 1000.0));
-  obj_.feActual.set(positionDemand_ ? std::llround(demand_ - measured_) : 0);
+  obj_.feActual.set(std::llround(followingErrorValue_));
   obj_.errorCode.set(errorCode_);
   publishExtra(now);
 }

@@ -20,8 +20,9 @@
 //    0x6083/0x6084), HM (bit 4 starts; methods 37 and 35: the present position is home;
 //    19 and 20: home switch, see DriveParams::homeSwitchCounts). Bit 8 halts PP, PV and HM.
 //  - limits: 0x6072 max torque (per mille), 0x6080 max motor speed (rpm, 0: none), 0x607D
-//    software position limits (position modes clamp their demand; velocity and torque modes
-//    stop pushing outwards) with bit 11 while one acts.
+//    software position limits on the unwrapped position (position modes clamp their demand;
+//    velocity and torque modes stop pushing outwards) with bit 11 while one acts; the whole
+//    DINT range (the default) or min >= max switches them off.
 //  - following error (position modes): 0x60F4 = demand - actual; beyond 0x6065 the warning
 //    bit 7 is set, beyond it for longer than 0x6066 ms bit 13 and fault 0x8611 in 0x603F
 //    (0x6065 = 0xFFFFFFFF switches monitoring off).
@@ -138,13 +139,17 @@ class Cia402Drive : public Application {
   // The servo command for this substep in Operation enabled.
   ServoCommand operate();
   ServoCommand stopping(bool faultReaction);
-  ServoCommand positionCommand(double position, double velocity);
-  ServoCommand velocityCommand(double velocity);
+  // Commands from counts, counts/s and counts/s^2 (the acceleration is fed forward as J a).
+  ServoCommand positionCommand(double position, double velocity, double acceleration = 0.0);
+  ServoCommand velocityCommand(double velocity, double acceleration = 0.0);
+  double feedForwardTorque(double acceleration) const;
   void startPpSetPoint(std::uint16_t controlword);
   void startHoming();
   void homingSubstep(double dt);
   void setHome();
   std::uint16_t modeStatusBits() const;
+  // 0x607D as a range; false when it sets no limit (empty, or the whole DINT range).
+  bool softwareLimits(double& min, double& max) const;
   double clampToLimits(double position);
   // +1 at or beyond the upper software limit, -1 at or below the lower one, else 0.
   int limitSide() const;
@@ -179,6 +184,7 @@ class Cia402Drive : public Application {
   double measured_{0.0};    // drive position, counts, unwrapped
   double demand_{0.0};      // position demand, counts, unwrapped (position modes)
   bool positionDemand_{false};
+  double followingErrorValue_{0.0};  // demand - actual at the last substep (0x60F4)
   bool internalLimit_{false};
   bool warning_{false};
   bool followingError_{false};

@@ -18,6 +18,13 @@ bool isMode(std::int8_t mode, Mode m) {
   return mode == static_cast<std::int8_t>(m);
 }
 
+// Share of the torque limit a "stop at the current limit" ramp uses (the rest is for the loops).
+constexpr double kTorqueLimitRampShare = 0.9;
+// Stopping ramps end with an exponential approach (seconds) plus a small constant share of the
+// deceleration, so they finish in finite time.
+constexpr double kStopLanding = 1e-3;
+constexpr double kStopLandingFloor = 0.02;
+
 double seconds(SimTime ns) {
   return static_cast<double>(ns) / static_cast<double>(kNsPerSecond);
 }
@@ -78,10 +85,20 @@ void Cia402Drive::latchModeInputs(std::uint16_t controlword, std::uint16_t previ
   }
 }
 
+bool Cia402Drive::softwareLimits(double& min, double& max) const {
+  constexpr std::int64_t kLowest = std::numeric_limits<std::int32_t>::min();
+  constexpr std::int64_t kHighest = std::numeric_limits<std::int32_t>::max();
+  const std::int64_t lo = obj_.limitMin.get(kLowest);
+  const std::int64_t hi = obj_.limitMax.get(kHighest);
+  min = static_cast<double>(lo);
+  max = static_cast<double>(hi);
+  // The whole DINT range (the default) and an empty range mean no limits.
+  return lo < hi && (lo != kLowest || hi != kHighest);
+}
+
 double Cia402Drive::clampToLimits(double position) {
-  const auto min = static_cast<double>(obj_.limitMin.get(std::numeric_limits<std::int32_t>::min()));
-  const auto max = static_cast<double>(obj_.limitMax.get(std::numeric_limits<std::int32_t>::max()));
-  if (min >= max) return position;
+  double min = 0.0, max = 0.0;
+  if (!softwareLimits(min, max)) return position;
   if (position < min || position > max) {
     internalLimit_ = true;
     return std::clamp(position, min, max);
@@ -89,35 +106,42 @@ double Cia402Drive::clampToLimits(double position) {
   return position;
 }
 
-ServoCommand Cia402Drive::positionCommand(double position, double velocity) {
+double Cia402Drive::feedForwardTorque(double acceleration) const {
+  return axis_.gains().accelerationFeedForward * params_.motor.inertia * acceleration *
+         countsToRad_;
+}
+
+ServoCommand Cia402Drive::positionCommand(double position, double velocity, double acceleration) {
   ServoCommand c;
   c.mode = ControlMode::kPosition;
   c.position = encoder_.angleOf(position - static_cast<double>(offset_));
   c.velocity = velocity * countsToRad_;
+  c.torque = feedForwardTorque(acceleration);
   c.torqueLimit = torqueLimitNm();
   c.velocityLimit = velocityLimitCounts() * countsToRad_;
   return c;
 }
 
 int Cia402Drive::limitSide() const {
-  const auto min = static_cast<double>(obj_.limitMin.get(std::numeric_limits<std::int32_t>::min()));
-  const auto max = static_cast<double>(obj_.limitMax.get(std::numeric_limits<std::int32_t>::max()));
-  if (min >= max) return 0;
+  double min = 0.0, max = 0.0;
+  if (!softwareLimits(min, max)) return 0;
   if (measured_ >= max) return 1;
   if (measured_ <= min) return -1;
   return 0;
 }
 
-ServoCommand Cia402Drive::velocityCommand(double velocity) {
+ServoCommand Cia402Drive::velocityCommand(double velocity, double acceleration) {
   // Software limits: no speed further outwards once at a limit.
   const int side = limitSide();
   if ((side > 0 && velocity > 0.0) || (side < 0 && velocity < 0.0)) {
     velocity = 0.0;
+    acceleration = 0.0;
     internalLimit_ = true;
   }
   ServoCommand c;
   c.mode = ControlMode::kVelocity;
   c.velocity = velocity * countsToRad_;
+  c.torque = feedForwardTorque(acceleration);
   c.torqueLimit = torqueLimitNm();
   c.velocityLimit = velocityLimitCounts() * countsToRad_;
   return c;
@@ -157,7 +181,7 @@ ServoCommand Cia402Drive::operate() {
     case Mode::kProfileVelocity: {
       const double target = halt_ ? 0.0 : std::clamp(velocityTarget_, -vmax, vmax);
       profile_.toVelocity(target, acc, dec, h);
-      return velocityCommand(profile_.velocity());
+      return velocityCommand(profile_.velocity(), profile_.acceleration());
     }
     case Mode::kProfilePosition: {
       if (halt_) {
@@ -174,12 +198,12 @@ ServoCommand Cia402Drive::operate() {
         }
       }
       demand_ = profile_.position();
-      return positionCommand(demand_, profile_.velocity());
+      return positionCommand(demand_, profile_.velocity(), profile_.acceleration());
     }
     case Mode::kHoming:
       homingSubstep(h);
       demand_ = profile_.position();
-      return positionCommand(demand_, profile_.velocity());
+      return positionCommand(demand_, profile_.velocity(), profile_.acceleration());
     default:
       return positionCommand(demand_, 0.0);  // no mode yet: hold
   }
@@ -193,17 +217,21 @@ ServoCommand Cia402Drive::stopping(bool faultReaction) {
   }
   const int option = faultReaction ? 2 : static_cast<int>(obj_.quickStopOption.get(2));
   if (holding_) return positionCommand(demand_, 0.0);
-  const bool atTorqueLimit = option == 3 || option == 4 || option == 7 || option == 8;
   double deceleration = params_.quickStopDeceleration;
   if (option == 1 || option == 5) {
     deceleration = static_cast<double>(obj_.profileDeceleration.getUnsigned(6553600));
+  } else if (option == 3 || option == 4 || option == 7 || option == 8) {
+    // "At the current limit": the ramp the torque limit allows, with a margin for the loops.
+    deceleration = kTorqueLimitRampShare * torqueLimitNm() / params_.motor.inertia / countsToRad_;
   }
-  if (atTorqueLimit) {
-    profile_.reset(measured_, 0.0);
-  } else {
-    profile_.toVelocity(0.0, deceleration, deceleration, h);
-  }
-  ServoCommand c = velocityCommand(profile_.velocity());
+  // The last part of the ramp eases off (deceleration proportional to the remaining speed,
+  // time constant kStopLanding), so the torque falls smoothly and the current loop can follow
+  // without the axis reversing.
+  const double landing =
+      std::abs(profile_.velocity()) / kStopLanding + kStopLandingFloor * deceleration;
+  deceleration = std::min(deceleration, landing);
+  profile_.toVelocity(0.0, deceleration, deceleration, h);
+  ServoCommand c = velocityCommand(profile_.velocity(), profile_.acceleration());
   const bool stopped =
       profile_.velocity() == 0.0 && std::abs(velocity()) <= params_.velocityThreshold;
   if (!stopped) return c;

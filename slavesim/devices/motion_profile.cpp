@@ -19,6 +19,7 @@ bool MotionProfile::toPosition(double target, double maxVelocity, double acceler
   maxVelocity = std::max(maxVelocity, 0.0);
   const double distance = target - position_;
   const double direction = sign(distance);
+  acceleration_ = 0.0;
   if (direction == 0.0 && velocity_ == 0.0) return true;
   const double v0 = velocity_;
   double v1 = 0.0;
@@ -43,6 +44,7 @@ bool MotionProfile::toPosition(double target, double maxVelocity, double acceler
   }
   position_ = next;
   velocity_ = v1;
+  acceleration_ = dt > 0.0 ? (v1 - v0) / dt : 0.0;
   return false;
 }
 
@@ -59,6 +61,7 @@ bool MotionProfile::toVelocity(double target, double acceleration, double decele
   if (v0 != 0.0 && sign(v1) != sign(v0) && sign(v1) != 0.0) v1 = 0.0;
   position_ += 0.5 * (v0 + v1) * dt;
   velocity_ = v1;
+  acceleration_ = dt > 0.0 ? (v1 - v0) / dt : 0.0;
   return v1 == target;
 }
 

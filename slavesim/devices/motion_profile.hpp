@@ -16,6 +16,7 @@ class MotionProfile {
   void reset(double position, double velocity) {
     position_ = position;
     velocity_ = velocity;
+    acceleration_ = 0.0;
   }
   // Shifts the position (a new home offset) without changing the motion.
   void shift(double delta) { position_ += delta; }
@@ -29,10 +30,13 @@ class MotionProfile {
 
   double position() const { return position_; }
   double velocity() const { return velocity_; }
+  // Mean acceleration of the last step (counts/s^2), for torque feed-forward.
+  double acceleration() const { return acceleration_; }
 
  private:
   double position_{0.0};
   double velocity_{0.0};
+  double acceleration_{0.0};
 };
 
 }  // namespace ecsim::slavesim::devices

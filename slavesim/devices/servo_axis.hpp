@@ -20,12 +20,13 @@
 namespace ecsim::slavesim::devices {
 
 struct ServoGains {
-  double positionKp{0.0};           // (rad/s)/rad
-  double velocityKp{0.0};           // N m/(rad/s)
-  double velocityTi{0.0};           // s; 0: no integral action
-  double currentKp{0.0};            // V/A
-  double currentTi{0.0};            // s; 0: no integral action
-  double velocityFeedForward{1.0};  // share of the demand speed added to w*
+  double positionKp{0.0};               // (rad/s)/rad
+  double velocityKp{0.0};               // N m/(rad/s)
+  double velocityTi{0.0};               // s; 0: no integral action
+  double currentKp{0.0};                // V/A
+  double currentTi{0.0};                // s; 0: no integral action
+  double velocityFeedForward{1.0};      // share of the demand speed added to w*
+  double accelerationFeedForward{1.0};  // share of J a (profile acceleration) added to T*
   // Loops tuned by the usual rules: current loop crossover at currentHz with its zero on the
   // winding pole (Kc = L wc, Tc = L/R), velocity loop crossover at velocityHz (Kv = J wv,
   // Tn = 4/wv), position gain wv/6.
