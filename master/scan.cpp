@@ -157,6 +157,15 @@ void ScanTask::queueDefaults() {
 
 void ScanTask::queueAddresses() {
   batch_.clear();
+  if (!options_.resetToDefaults) {
+    // Leave the slaves as they are, but the SII must be readable from the EtherCAT side.
+    for (std::uint8_t value : {std::uint8_t{0x02}, std::uint8_t{0x00}}) {
+      const std::array<std::uint8_t, 1> data{value};
+      batch_.add().prepare(Command::kBwr,
+                           DatagramHeader::physical(0, reg::kSiiConfiguration.address), data,
+                           static_cast<std::uint16_t>(slaves_.size()));
+    }
+  }
   for (auto& slave : slaves_) {
     std::array<std::uint8_t, 2> address{};
     writeLe16(address, 0, slave.station);

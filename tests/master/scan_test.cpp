@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "master/state_change.hpp"
 #include "tests/master/sim_network.hpp"
 #include "tests/master/test_slaves.hpp"
 
@@ -167,6 +168,34 @@ TEST(ScanTest, SiiReadErrorsNameTheSlave) {
       << result.status.error().context;
   EXPECT_NE(result.status.error().context.find("SII read of word 0x0000"), std::string::npos)
       << result.status.error().context;
+}
+
+TEST(ScanTest, ScanWithoutResetLeavesTheStatesAlone) {
+  SimNetwork net;
+  for (int i = 0; i < 2; ++i) net.segment().addSlave(slavesim::makeGenericSlave("G", 0));
+  net.segment().wireLine();
+  net.start();
+  Transport transport(net.masterLink());
+  std::vector<SlaveInfo> slaves;
+  master::ScanTask first(transport, slaves);
+  first.start(0);
+  ASSERT_TRUE(master::runTask(first, transport, net.bus(), kNsPerSecond).ok());
+  master::StateChangeTask preop(transport, slaves);
+  preop.start(AlState::kPreOp, net.clock().now());
+  ASSERT_TRUE(master::runTask(preop, transport, net.bus(), kNsPerSecond).ok());
+  ASSERT_TRUE(preop.status().ok());
+
+  master::ScanOptions look;
+  look.resetToDefaults = false;
+  auto again = scan(net, look);
+  ASSERT_TRUE(again.status.ok()) << again.status.error().message();
+  EXPECT_EQ(again.slaves[1].state(), AlState::kPreOp);
+  EXPECT_EQ(again.slaves[1].name, "G");
+  EXPECT_EQ(net.segment().slave(1).state(), AlState::kPreOp);
+  // A start-up scan resets them.
+  auto reset = scan(net);
+  ASSERT_TRUE(reset.status.ok());
+  EXPECT_EQ(net.segment().slave(1).state(), AlState::kInit);
 }
 
 }  // namespace
