@@ -68,6 +68,12 @@ Result<TopologySlave> parseSlave(const xml::Context& ctx, const Element* e,
     return ctx.error(e, "Slave '" + s.name + "': give either esi+product or device, not both");
   }
   if (const char* esc = e->Attribute("esc")) s.esc = esc;
+  if (const char* dc = e->Attribute("dc")) {
+    s.dc = dc;
+    if (s.dc != "full" && s.dc != "delay-only" && s.dc != "none") {
+      return ctx.error(e, "dc must be full, delay-only or none");
+    }
+  }
   ECSIM_ASSIGN_OR_RETURN(s.processingDelayNs,
                          xml::attrNumber<std::int64_t>(ctx, e, "processingDelayNs"));
   ECSIM_ASSIGN_OR_RETURN(s.forwardingDelayNs,

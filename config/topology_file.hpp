@@ -30,7 +30,8 @@ struct TopologySlave {
   std::optional<std::uint32_t> revision;  // absent: the highest revision in the file
   std::string builtin;                    // "generic" when no ESI device is named
   std::filesystem::path eepromFile;       // a device given by a raw SII dump instead
-  std::string esc;  // ESC model; empty: the device's choice (generic devices: ET1100)
+  std::string esc;         // ESC model; empty: the device's choice (generic devices: ET1100)
+  std::string dc{"full"};  // DC unit: full, delay-only (receive times only), none
   std::optional<std::int64_t> processingDelayNs;
   std::optional<std::int64_t> forwardingDelayNs;
   std::int64_t clockOffsetNs{0};

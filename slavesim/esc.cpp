@@ -310,8 +310,9 @@ bool Esc::writeMemory(std::uint32_t address, ConstBytes data) {
     int smIndex = smLookup(at, limit);
     if (smIndex < 0 && at < kRamStart) {
       std::uint32_t n = std::min<std::uint32_t>(limit, kRamStart) - at;
-      writeRegisters(static_cast<std::uint16_t>(at), piece.first(n));
-      any |= implemented(at, n);
+      // A write only counts when some byte of it is writable (real ESCs give no WKC for a
+      // write to read-only registers such as 0x092C: replay-dc.pcapng frame 75).
+      any |= writeRegisters(static_cast<std::uint16_t>(at), piece.first(n)) && implemented(at, n);
       at += n;
       continue;
     }
@@ -323,26 +324,28 @@ bool Esc::writeMemory(std::uint32_t address, ConstBytes data) {
 }
 
 bool Esc::implemented(std::uint32_t at, std::uint32_t n) const {
-  // Registers of FMMU and SM channels beyond what the ESC has do not exist: an access that
-  // touches only those gets no working-counter increment (seen on real ET1200 terminals,
-  // docs/fidelity.md). Everything else in the register space answers.
+  // Registers of FMMU and SM channels beyond what the ESC has, and of a DC unit it lacks, do
+  // not exist: an access that touches only those gets no working-counter increment (seen on
+  // real ET1200 terminals and an EK1100, docs/fidelity.md). Everything else answers.
   const std::uint32_t end = at + n;
   const std::uint32_t fmmuEnd =
       reg::kFmmuBase + reg::kFmmuSize * static_cast<std::uint32_t>(type_.fmmus);
   const std::uint32_t smEnd =
       reg::kSmBase + reg::kSmSize * static_cast<std::uint32_t>(type_.syncManagers);
+  constexpr std::uint32_t kDcBegin = reg::kReceiveTimePort0.address;
+  constexpr std::uint32_t kDcEnd = 0x0A00;
+  constexpr std::uint32_t kDelayOnlyEnd = reg::kReceiveTimePort3.end();
   for (std::uint32_t a = at; a < end; ++a) {
     if (a >= reg::kFmmuBase && a < reg::kFmmuBase + reg::kFmmuSize * reg::kMaxFmmus) {
       if (a < fmmuEnd) return true;
-      a = reg::kFmmuBase + reg::kFmmuSize * reg::kMaxFmmus - 1;
-      continue;
-    }
-    if (a >= reg::kSmBase && a < reg::kSmBase + reg::kSmSize * reg::kMaxSyncManagers) {
+    } else if (a >= reg::kSmBase && a < reg::kSmBase + reg::kSmSize * reg::kMaxSyncManagers) {
       if (a < smEnd) return true;
-      a = reg::kSmBase + reg::kSmSize * reg::kMaxSyncManagers - 1;
-      continue;
+    } else if (a >= kDcBegin && a < kDcEnd) {
+      if (dcUnit_ == DcUnit::kFull || (dcUnit_ == DcUnit::kDelayOnly && a < kDelayOnlyEnd))
+        return true;
+    } else {
+      return true;
     }
-    return true;
   }
   return false;
 }
@@ -499,7 +502,7 @@ bool Esc::writeRam(std::uint16_t address, ConstBytes data, int smIndex) {
 
 namespace ecsim::slavesim {
 
-void Esc::writeRegisters(std::uint16_t address, ConstBytes data) {
+bool Esc::writeRegisters(std::uint16_t address, ConstBytes data) {
   const std::uint32_t begin = address;
   const std::uint32_t end = address + static_cast<std::uint32_t>(data.size());
   // SM channel registers 0x0800-0x0804 are writable only while the SM is disabled
@@ -510,6 +513,8 @@ void Esc::writeRegisters(std::uint16_t address, ConstBytes data) {
     smWasEnabled[s] =
         (memory_[reg::smChannel(s) + reg::sm::kActivate.address] & reg::sm::kActivateEnable) != 0;
   }
+  bool accepted = false;
+  for (std::uint32_t a = begin; a < end && !accepted; ++a) accepted = writable_[a] != 0;
   bool errorCounterWrite = false;
   bool lostLinkWrite = false;
   // Fast path (cyclic DC writes, AL control, ...): no register with per-byte special rules.
@@ -606,6 +611,7 @@ void Esc::writeRegisters(std::uint16_t address, ConstBytes data) {
     rebuildSmCache();
     events_.smConfigChanged = true;
   }
+  return accepted;
 }
 
 void Esc::smActivationChanged(unsigned s) {

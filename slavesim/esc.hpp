@@ -66,6 +66,13 @@ class Esc {
   bool receiveTimeLatchArmed() const { return latchArmed_; }
   void completeReceiveTimeLatch(const std::array<SimTime, 4>& times, std::uint8_t portMask);
 
+  // Which distributed-clock unit this ESC has (ESC datasheet section I §9.1: full DC,
+  // propagation-delay measurement only — the port receive times, as in an EK1100 — or none).
+  // Registers of a missing unit answer without a working-counter increment.
+  enum class DcUnit : std::uint8_t { kFull, kDelayOnly, kNone };
+  void setDcUnit(DcUnit unit) { dcUnit_ = unit; }
+  DcUnit dcUnit() const { return dcUnit_; }
+
   // The ESC's local clock (oscillator offset and drift, and the DC control loop).
   DcClock& dcClock() { return dc_; }
   const DcClock& dcClock() const { return dc_; }
@@ -185,7 +192,8 @@ class Esc {
   // Process RAM access for one contiguous piece inside one SM (sm >= 0) or outside any (-1).
   bool readRam(std::uint16_t address, Bytes out, bool orInto, int sm);
   bool writeRam(std::uint16_t address, ConstBytes data, int sm);
-  void writeRegisters(std::uint16_t address, ConstBytes data);
+  // Returns false when no byte of the range is writable for ECAT (no WKC then).
+  bool writeRegisters(std::uint16_t address, ConstBytes data);
   void refreshVolatile(std::uint16_t begin, std::uint16_t end);
   void siiCommand(std::uint16_t control);
   void smActivationChanged(unsigned sm);
@@ -216,6 +224,7 @@ class Esc {
   std::vector<std::uint8_t> lastMailboxResponse_;
   std::size_t lastMailboxResponseSize_{0};
   bool latchArmed_{false};
+  DcUnit dcUnit_{DcUnit::kFull};
   DcClock dc_;
   SimTime now_{0};       // simulation time of the datagram being processed
   SimTime localNow_{0};  // local time of the datagram being processed

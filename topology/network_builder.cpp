@@ -108,6 +108,10 @@ Result<Network> buildNetwork(const TopologyConfig& config) {
       e.context = config.file.string() + ", slave '" + entry.name + "': " + e.context;
       return e;
     }
+    auto& made = *slave.value();
+    made.esc().setDcUnit(entry.dc == "none"         ? slavesim::Esc::DcUnit::kNone
+                         : entry.dc == "delay-only" ? slavesim::Esc::DcUnit::kDelayOnly
+                                                    : slavesim::Esc::DcUnit::kFull);
     const std::size_t i = seg.addSlave(std::move(slave).value());
     seg.setClock(i, entry.clockOffsetNs, entry.driftPpm);
     const auto& type = seg.slave(i).esc().type();

@@ -47,10 +47,11 @@ std::string ReplayDifference::describe() const {
   return s.str();
 }
 
-Result<ReplayReport> replayCapture(const std::vector<PcapRecord>& capture, Segment& segment) {
+Result<ReplayReport> replayCapture(const std::vector<PcapRecord>& capture, Segment& segment,
+                                   std::optional<SimTime> timeOrigin) {
   ReplayReport report;
   report.framesInCapture = capture.size();
-  SimTime start = capture.empty() ? 0 : capture.front().timestampNs;
+  SimTime start = timeOrigin.value_or(capture.empty() ? 0 : capture.front().timestampNs);
   std::array<std::uint8_t, kMaxFrameSize> buffer{};
   for (std::size_t i = 0; i < capture.size(); ++i) {
     const PcapRecord& rec = capture[i];

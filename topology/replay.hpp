@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,7 +44,11 @@ struct ReplayReport {
 };
 
 // Pairs each master frame (source MAC without the locally administered bit) with the next
-// returned frame (bit set) carrying the same first datagram index.
-Result<ReplayReport> replayCapture(const std::vector<PcapRecord>& capture, Segment& segment);
+// returned frame (bit set) carrying the same first datagram index. Each master frame enters
+// the network at simulation time (capture timestamp - timeOrigin); by default timeOrigin is
+// the first frame's timestamp. Give the capture's own origin to reproduce DC times exactly
+// (for captures made by ecsim, stamped with model time).
+Result<ReplayReport> replayCapture(const std::vector<PcapRecord>& capture, Segment& segment,
+                                   std::optional<SimTime> timeOrigin = std::nullopt);
 
 }  // namespace ecsim::topology

@@ -99,10 +99,38 @@ TEST_F(Commands, FrmwDistributesTheReferenceValue) {
   EXPECT_EQ(seg_.slave(2).esc().reg32(0x0F80), 0x01020304u);
 }
 
-TEST_F(Commands, ReadOnlyRegistersIgnoreWritesButCount) {
+TEST_F(Commands, WritesToReadOnlyRegistersAreIgnoredAndNotCounted) {
+  // Real ESCs give no WKC for a write that changes nothing: a BWR to 0x092C (read-only) came
+  // back with WKC 0 from EK1100 + EL2828 + EL2889 (../shared/pcap/replay-dc.pcapng frame 75).
   auto r = one(seg_, Command::kBwr, phys(0, 0x0000), {0x55});
-  EXPECT_EQ(r.wkc, 3);
+  EXPECT_EQ(r.wkc, 0);
   EXPECT_EQ(seg_.slave(0).esc().reg8(0x0000), slavesim::kEt1100.typeRegister);
+  EXPECT_EQ(one(seg_, Command::kBwr, phys(0, 0x092C), {1, 2, 3, 4}).wkc, 0);
+  // A write that touches a writable byte counts, even if others in it are read-only.
+  EXPECT_EQ(one(seg_, Command::kBwr, phys(0, 0x000E), {0, 0, 0x34, 0x12}).wkc, 3);
+  EXPECT_EQ(seg_.slave(2).esc().reg16(0x0010), 0x1234);
+}
+
+TEST_F(Commands, MissingFmmuAndSmChannelsAreNotCounted) {
+  // ET1200 terminals have 3 FMMUs and 4 SMs: writes to FMMU3 or SM4 are not theirs
+  // (replay-dc.pcapng frames 11-35, 45-67: only the ET1100 coupler answered).
+  topology::Segment seg;
+  seg.addSlave(makeSlave("et1100", 1));
+  seg.addSlave(std::make_unique<slavesim::Slave>("et1200", slavesim::kEt1200, makeSii(1, 2),
+                                                 slavesim::SlaveProfile{}));
+  seg.wireLine();
+  EXPECT_EQ(one(seg, Command::kBwr, phys(0, 0x0620), std::vector<std::uint8_t>(16, 0)).wkc, 2);
+  EXPECT_EQ(one(seg, Command::kBwr, phys(0, 0x0630), std::vector<std::uint8_t>(16, 0)).wkc, 1);
+  EXPECT_EQ(one(seg, Command::kBwr, phys(0, 0x0820), std::vector<std::uint8_t>(8, 0)).wkc, 1);
+  EXPECT_EQ(one(seg, Command::kBrd, phys(0, 0x0830), std::vector<std::uint8_t>(8, 0)).wkc, 1);
+}
+
+TEST_F(Commands, DelayOnlyDcUnitAnswersReceiveTimesOnly) {
+  seg_.slave(1).esc().setDcUnit(slavesim::Esc::DcUnit::kDelayOnly);
+  seg_.slave(2).esc().setDcUnit(slavesim::Esc::DcUnit::kNone);
+  EXPECT_EQ(one(seg_, Command::kBwr, phys(0, 0x0900), {0, 0, 0, 0}).wkc, 2);
+  EXPECT_EQ(one(seg_, Command::kBrd, phys(0, 0x0910), std::vector<std::uint8_t>(8, 0)).wkc, 1);
+  EXPECT_EQ(one(seg_, Command::kBwr, phys(0, 0x0981), {0}).wkc, 1);
 }
 
 TEST_F(Commands, ErrorCountersClearOnWrite) {
