@@ -97,7 +97,7 @@ TEST(Replay, RealDcCaptureRunsToTheEndAgainstTheTerminalsSiiDumps) {
     EXPECT_NE(d.frameNumber, 1u) << d.describe();
   }
   // What still differs is listed and explained in docs/fidelity.md; keep it from growing.
-  EXPECT_LE(report->wkcMismatches, 375u);
+  EXPECT_EQ(report->wkcMismatches, 0u);
   EXPECT_LE(report->dataMismatches, 609u);
 }
 
