@@ -9,19 +9,23 @@
 namespace ecsim::topology {
 namespace {
 
-bool returned(const PcapRecord& r) {
-  return r.data.size() > 6 && (r.data[6] & 0x02) != 0;
+// Same first datagram index and the same sequence of commands and lengths.
+bool sameShape(const std::vector<std::uint8_t>& a, const std::vector<std::uint8_t>& b) {
+  auto fa = ConstEtherCatFrame::parse(ConstBytes(a));
+  auto fb = ConstEtherCatFrame::parse(ConstBytes(b));
+  if (!fa.ok() || !fb.ok() || fa->datagramCount() != fb->datagramCount()) return false;
+  for (auto x = fa->begin(), y = fb->begin(); x != fa->end() && y != fb->end(); ++x, ++y) {
+    if ((*x).rawCommand() != (*y).rawCommand() || (*x).index() != (*y).index() ||
+        (*x).length() != (*y).length()) {
+      return false;
+    }
+  }
+  return true;
 }
 
 bool isEtherCat(const PcapRecord& r) {
   auto eth = EthernetHeader::parse(r.data);
   return eth.ok() && eth->etherType == kEtherTypeEtherCat;
-}
-
-std::uint8_t firstIndex(const std::vector<std::uint8_t>& frame) {
-  auto eth = EthernetHeader::parse(frame);
-  const std::size_t at = eth.ok() ? eth->size() + kEtherCatHeaderSize + 1 : 0;
-  return at < frame.size() ? frame[at] : 0;
 }
 
 bool inTimeRegisters(const DatagramHeader& h, std::size_t offset) {
@@ -53,25 +57,24 @@ Result<ReplayReport> replayCapture(const std::vector<PcapRecord>& capture, Segme
   report.framesInCapture = capture.size();
   SimTime start = timeOrigin.value_or(capture.empty() ? 0 : capture.front().timestampNs);
   std::array<std::uint8_t, kMaxFrameSize> buffer{};
+  std::vector<bool> isAnswer(capture.size(), false);
   for (std::size_t i = 0; i < capture.size(); ++i) {
     const PcapRecord& rec = capture[i];
     if (!isEtherCat(rec)) {
       ++report.otherFrames;
       continue;
     }
-    if (returned(rec)) continue;
+    if (isAnswer[i]) continue;
     ++report.masterFrames;
-    // The recorded answer: the next returned frame with the same first index.
+    // The recorded answer: the next frame with the same first index and the same datagram
+    // commands (a master's own source MAC may carry the locally administered bit too, so
+    // the ESCs' marking alone cannot tell requests from answers).
     const PcapRecord* answer = nullptr;
     for (std::size_t j = i + 1; j < capture.size() && j < i + 64; ++j) {
-      if (isEtherCat(capture[j]) && returned(capture[j]) &&
-          firstIndex(capture[j].data) == firstIndex(rec.data)) {
+      if (!isAnswer[j] && isEtherCat(capture[j]) && sameShape(rec.data, capture[j].data)) {
         answer = &capture[j];
+        isAnswer[j] = true;
         break;
-      }
-      if (isEtherCat(capture[j]) && !returned(capture[j]) &&
-          firstIndex(capture[j].data) == firstIndex(rec.data)) {
-        break;  // re-sent before an answer came: this one was lost
       }
     }
     if (rec.data.size() > buffer.size()) {

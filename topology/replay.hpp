@@ -43,8 +43,8 @@ struct ReplayReport {
   }
 };
 
-// Pairs each master frame (source MAC without the locally administered bit) with the next
-// returned frame (bit set) carrying the same first datagram index. Each master frame enters
+// Pairs each master frame with the next frame of the same shape (first datagram index,
+// commands and lengths): the answer the capture holds for it. Each master frame enters
 // the network at simulation time (capture timestamp - timeOrigin); by default timeOrigin is
 // the first frame's timestamp. Give the capture's own origin to reproduce DC times exactly
 // (for captures made by ecsim, stamped with model time).

@@ -1,151 +1,132 @@
-// `ecsim demo`: the one-command tour. Builds a simulated line of slaves in-process, talks to
-// it through an in-memory link exactly as a master would on a wire (frames only), captures
-// every frame to a pcap, and prints what it found.
+// `ecsim demo`: the one-command tour. The demo network (examples/topologies/demo.xml) runs
+// in-process on virtual time; our master brings every slave INIT -> PREOP -> SAFEOP -> OP
+// through frames only (the same code that runs on a real interface), runs 100 cycles of 1 ms
+// with a running light on the digital outputs, and every frame at the master's cable is
+// captured to demo.pcap, stamped with model time. Everything is deterministic: the same run
+// gives the same bytes.
 #include <fmt/core.h>
 
-#include <array>
 #include <filesystem>
 #include <optional>
 #include <string>
-#include <vector>
 
+#include "config/topology_file.hpp"
 #include "link/memory_link.hpp"
 #include "link/pcap.hpp"
-#include "link/pcap_tap.hpp"
+#include "master/bus.hpp"
+#include "master/master.hpp"
+#include "master/process_image.hpp"
 #include "protocol/al_status.hpp"
-#include "protocol/frame.hpp"
-#include "protocol/registers.hpp"
-#include "slavesim/generic_slave.hpp"
 #include "tools/ecsim/commands.hpp"
+#include "topology/network_builder.hpp"
 #include "topology/network_server.hpp"
+#include "topology/pcap_cable_tap.hpp"
 
 namespace ecsim::tools {
 namespace {
 
 struct DemoOptions {
   std::string out{"ecsim-demo"};
-  unsigned slaves{5};
+  std::string topology;
+  unsigned cycles{100};
 };
 
-// One request/answer exchange through the simulated network, stepping it in this thread.
-class Exchanger {
- public:
-  Exchanger(Link& master, topology::NetworkServer& server, VirtualClock& clock)
-      : master_(master), server_(server), clock_(clock) {}
-
-  std::optional<std::pair<std::vector<std::uint8_t>, std::uint16_t>> run(
-      Command cmd, std::uint32_t address, std::vector<std::uint8_t> data) {
-    std::array<std::uint8_t, kMaxFrameSize> buf{};
-    FrameBuilder b(
-        buf,
-        EthernetHeader{kBroadcastMac, {0x02, 0, 0, 0, 0, 0x01}, std::nullopt, kEtherTypeEtherCat});
-    if (!b.add(cmd, index_++, address, data).ok()) return std::nullopt;
-    auto len = b.finish();
-    if (!len.ok() || !master_.send(ConstBytes(buf.data(), *len)).ok()) return std::nullopt;
-    if (!server_.step().ok()) return std::nullopt;
-    clock_.advance(100 * kNsPerUs);
-    auto got = master_.receive(buf, std::chrono::milliseconds(100));
-    if (!got.ok() || *got == 0) return std::nullopt;
-    auto frame = EtherCatFrame::parse(std::span(buf.data(), *got));
-    if (!frame.ok()) return std::nullopt;
-    auto d = *frame->begin();
-    return std::make_pair(std::vector<std::uint8_t>(d.data().begin(), d.data().end()), d.wkc());
+std::string defaultDemoTopology() {
+  if (const char* dir = std::getenv("ECSIM_DATA_DIR")) {
+    return (std::filesystem::path(dir) / "topologies" / "demo.xml").string();
   }
-
-  // Reads `words` SII words of the slave at station address `station` through 0x0502/0x0508.
-  std::vector<std::uint8_t> readSii(std::uint16_t station, std::uint32_t word, unsigned words) {
-    std::vector<std::uint8_t> out;
-    for (unsigned w = 0; w < words; w += 2) {
-      std::vector<std::uint8_t> cmd(6, 0);
-      writeLe16(cmd, 0, reg::sii::kCommandRead);
-      writeLe32(cmd, 2, word + w);
-      run(Command::kFpwr, DatagramHeader::physical(station, reg::kSiiControlStatus.address), cmd);
-      auto r = run(Command::kFprd, DatagramHeader::physical(station, reg::kSiiData.address),
-                   std::vector<std::uint8_t>(4, 0));
-      if (!r) break;
-      out.insert(out.end(), r->first.begin(), r->first.end());
-    }
-    return out;
-  }
-
- private:
-  Link& master_;
-  topology::NetworkServer& server_;
-  VirtualClock& clock_;
-  std::uint8_t index_{0};
-};
+  const std::filesystem::path installed = ECSIM_INSTALLED_DATA_DIR "/topologies/demo.xml";
+  if (std::filesystem::exists(installed)) return installed.string();
+  return ECSIM_SOURCE_DATA_DIR "/topologies/demo.xml";
+}
 
 int runDemo(const DemoOptions& o) {
   std::filesystem::create_directories(o.out);
   const std::string pcapPath = (std::filesystem::path(o.out) / "demo.pcap").string();
-  topology::Segment segment;
-  for (unsigned i = 0; i < o.slaves; ++i) {
-    segment.addSlave(slavesim::makeGenericSlave(fmt::format("Slave{}", i + 1), 1000 + i));
+  const std::string topologyPath = o.topology.empty() ? defaultDemoTopology() : o.topology;
+  auto config = loadTopologyFile(topologyPath);
+  if (!config.ok()) {
+    fmt::print(stderr, "ecsim demo: {}\n", config.error().message());
+    return 1;
   }
-  segment.wireLine();
-  auto [masterEnd, networkEnd] = MemoryLink::makePair();
-  VirtualClock clock(kNsPerSecond);
+  auto network = topology::buildNetwork(*config);
+  if (!network.ok()) {
+    fmt::print(stderr, "ecsim demo: {}\n", network.error().message());
+    return 1;
+  }
+  topology::Segment& segment = *network->segment;
   auto writer = PcapWriter::open(pcapPath);
   if (!writer.ok()) {
     fmt::print(stderr, "ecsim demo: {}\n", writer.error().message());
     return 1;
   }
-  // Capture at the master's port, stamped with model time from 2000-01-01 (the DC epoch).
-  class EpochClock final : public Clock {
-   public:
-    explicit EpochClock(const Clock& c) : c_(c) {}
-    SimTime now() const override { return c_.now() + kDcEpochUnixNs; }
+  // Model time 0 is 2000-01-01 (the DC epoch) in the capture: deterministic timestamps.
+  topology::PcapCableTap tap(*writer, kDcEpochUnixNs);
+  segment.setCableObserver(0, 0, &tap);
 
-   private:
-    const Clock& c_;
-  } stamp(clock);
-  PcapTap tap(masterEnd, *writer, stamp);
-  topology::NetworkServer server(networkEnd, segment, clock);
-  Exchanger x(tap, server, clock);
+  auto [masterEnd, networkEnd] = MemoryLink::makePair(256);
+  VirtualClock clock(kNsPerSecond);
+  topology::ServerOptions serverOptions;
+  serverOptions.idleWait = std::chrono::nanoseconds(0);
+  topology::NetworkServer server(networkEnd, segment, clock, serverOptions);
+  // The virtual bus steps the simulator whenever the master waits; a frame is back after
+  // its modelled round trip.
+  master::VirtualBus bus(clock, [&](SimTime) -> std::optional<SimTime> {
+    const bool waiting = networkEnd.pending() > 0;
+    const auto before = server.counters().framesAnswered;
+    (void)server.step();
+    if (waiting && server.counters().framesAnswered != before)
+      return server.counters().lastRoundTrip;
+    return std::nullopt;
+  });
+  master::Master m(masterEnd, bus);
 
-  fmt::print("ecsim demo: a simulated EtherCAT line of {} slaves, driven through frames only\n\n",
-             o.slaves);
-  auto count = x.run(Command::kBrd, DatagramHeader::physical(0, reg::kType.address), {0, 0});
-  if (!count) {
-    fmt::print(stderr, "ecsim demo: no answer from the network\n");
+  fmt::print("ecsim demo: network '{}' from {}\n", config->name, topologyPath);
+  fmt::print("our master brings every slave to OP through frames only...\n\n");
+  if (auto s = m.start(); !s.ok()) {
+    fmt::print(stderr, "ecsim demo: start failed: {}\n", s.error().message());
     return 1;
   }
-  fmt::print("BRD 0x0000 -> working counter {} (slaves answering)\n", count->second);
-  fmt::print("{:>4}  {:>7}  {:>10}  {:>10}  {:>8}  {:>6}  {}\n", "pos", "station", "vendor",
-             "product", "serial", "state", "name");
-  for (std::uint16_t pos = 0; pos < count->second; ++pos) {
-    const auto station = static_cast<std::uint16_t>(0x1001 + pos);
-    std::vector<std::uint8_t> addr(2);
-    writeLe16(addr, 0, station);
-    x.run(Command::kApwr,
-          DatagramHeader::physical(static_cast<std::uint16_t>(-pos),
-                                   reg::kConfiguredStationAddress.address),
-          addr);
-    auto ident = x.readSii(station, 0x08, 8);
-    auto al =
-        x.run(Command::kFprd, DatagramHeader::physical(station, reg::kAlStatus.address), {0, 0});
-    // String 1 (the device name) sits in the STRINGS category right after the header.
-    auto strings = x.readSii(station, 0x40, 16);
-    std::string name;
-    if (strings.size() >= 6 && readLe16(strings, 0) == 10 && strings[4] >= 1) {
-      std::size_t len = strings[5];
-      for (std::size_t i = 0; i < len && 6 + i < strings.size(); ++i) {
-        name.push_back(static_cast<char>(strings[6 + i]));
-      }
-    }
-    std::string state = al ? std::string(toString(static_cast<AlState>(al->first[0] & 0x0F))) : "?";
-    fmt::print("{:>4}  {:#07x}  {:#010x}  {:#010x}  {:>8}  {:>6}  {}\n", pos, station,
-               ident.size() >= 16 ? readLe32(ident, 0) : 0u,
-               ident.size() >= 16 ? readLe32(ident, 4) : 0u,
-               ident.size() >= 16 ? readLe32(ident, 12) : 0u, state, name);
+  fmt::print("{:>3}  {:>7}  {:>10}  {:>10}  {:>6}  {}\n", "pos", "station", "vendor", "product",
+             "state", "name");
+  for (const auto& s : m.slaves()) {
+    fmt::print("{:>3}  {:#07x}  {:#010x}  {:#010x}  {:>6}  {}\n", s.position, s.station,
+               s.identity().vendorId, s.identity().productCode,
+               s.state() ? std::string(toString(*s.state())) : std::string("?"), s.name);
   }
-  (void)writer->close();
-  const auto& c = server.counters();
+  // A running light on the first 8-bit output variable block (the DO terminal).
+  std::optional<std::size_t> lightByte;
+  for (const auto& v : master::processVariables(m.layout())) {
+    if (v.output && v.bitLength == 1 && v.bitOffset % 8 == 0 && v.index == 0x7000) {
+      lightByte = v.bitOffset / 8;
+      break;
+    }
+  }
+  const SimTime start = clock.now();
+  for (unsigned c = 0; c < o.cycles; ++c) {
+    if (lightByte) {
+      std::uint8_t pattern = static_cast<std::uint8_t>(1u << (c % 8));
+      (void)m.writeData(*lightByte, ConstBytes(&pattern, 1));
+    }
+    if (auto s = m.exchange(); !s.ok()) {
+      fmt::print(stderr, "ecsim demo: cycle {}: {}\n", c, s.error().message());
+    }
+    clock.set(start + static_cast<SimTime>(c + 1) * kNsPerMs);
+  }
+  const auto& st = m.statistics();
   fmt::print(
-      "\nframes answered {}, malformed {}, capture: {} (open it with Wireshark or "
-      "`tshark -r {}`)\n",
-      c.framesAnswered, c.framesDropped, pcapPath, pcapPath);
-  return 0;
+      "\n{} cycles of 1 ms: {} WKC errors, {} lost frames; round trip min {:.1f} us, "
+      "mean {:.1f} us, max {:.1f} us\n",
+      st.cycles, st.wkcErrors, st.framesLost, static_cast<double>(st.roundTripMin) / 1e3,
+      static_cast<double>(st.roundTripMean()) / 1e3, static_cast<double>(st.roundTripMax) / 1e3);
+  if (auto s = m.stop(); !s.ok()) {
+    fmt::print(stderr, "ecsim demo: stop: {}\n", s.error().message());
+  }
+  segment.setCableObserver(0, 0, nullptr);
+  (void)writer->close();
+  fmt::print("all slaves back in INIT; {} frames captured in {} (tshark -r {})\n",
+             server.counters().framesAnswered * 2, pcapPath, pcapPath);
+  return st.wkcErrors == 0 && st.framesLost == 0 ? 0 : 1;
 }
 
 }  // namespace
@@ -154,8 +135,9 @@ CommandRunner addDemoCommand(CLI::App& app) {
   auto opts = std::make_shared<DemoOptions>();
   auto* cmd = app.add_subcommand("demo", "Run the one-command tour and print a summary");
   cmd->add_option("--out", opts->out, "Directory for the demo's files (pcap, CSV, plots)");
-  cmd->add_option("--slaves", opts->slaves, "Slaves in the demo line")
-      ->check(CLI::Range(1u, 1000u));
+  cmd->add_option("--topology", opts->topology, "Network to tour (default: the demo network)");
+  cmd->add_option("--cycles", opts->cycles, "Cyclic exchanges to run")
+      ->check(CLI::Range(1u, 1000000u));
   return [opts] { return runDemo(*opts); };
 }
 

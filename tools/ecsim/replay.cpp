@@ -2,6 +2,8 @@
 // simulated network and report, frame by frame, where the answers differ from the recorded.
 #include <fmt/core.h>
 
+#include <optional>
+
 #include "config/topology_file.hpp"
 #include "link/pcap.hpp"
 #include "tools/ecsim/commands.hpp"
@@ -15,6 +17,7 @@ struct ReplayOptions {
   std::string capture;
   std::string topology;
   std::size_t show{40};
+  std::optional<SimTime> timeOrigin;
 };
 
 int runReplay(const ReplayOptions& o) {
@@ -35,7 +38,7 @@ int runReplay(const ReplayOptions& o) {
     fmt::print(stderr, "ecsim replay: {}\n", network.error().message());
     return 1;
   }
-  auto report = topology::replayCapture(*records, *network->segment);
+  auto report = topology::replayCapture(*records, *network->segment, o.timeOrigin);
   if (!report.ok()) {
     fmt::print(stderr, "ecsim replay: {}\n", report.error().message());
     return 1;
@@ -66,6 +69,9 @@ CommandRunner addReplayCommand(CLI::App& app) {
   cmd->add_option("capture", opts->capture, "pcap or pcapng file")->required();
   cmd->add_option("--topology", opts->topology, "Topology to replay against (default: demo)");
   cmd->add_option("--show", opts->show, "Differences to print");
+  cmd->add_option("--time-origin", opts->timeOrigin,
+                  "Capture timestamp (ns) of simulation time 0; default: the first frame's. "
+                  "Captures by ecsim serve/demo are stamped from 2000-01-01: 946684800000000000");
   return [opts] { return runReplay(*opts); };
 }
 
