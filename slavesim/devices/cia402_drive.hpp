@@ -91,7 +91,9 @@ class Cia402Drive : public Application {
   bool homingAttained() const { return homingAttained_; }
 
   ServoAxis& axis() { return axis_; }
+  const ServoAxis& axis() const { return axis_; }
   Encoder& encoder() { return encoder_; }
+  const Encoder& encoder() const { return encoder_; }
   const DriveParams& params() const { return params_; }
   // Raises a fault from outside (fault injection): fault reaction, then Fault with `code`.
   void injectFault(std::uint16_t code);

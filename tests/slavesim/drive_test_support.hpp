@@ -5,14 +5,17 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "config/esi.hpp"
 #include "slavesim/devices/cia402.hpp"
 #include "slavesim/devices/cia402_drive.hpp"
 #include "slavesim/devices/robot_drive.hpp"
 #include "slavesim/esi_slave.hpp"
+#include "tests/slavesim/coe_test_support.hpp"
 
 namespace ecsim::testing {
 
@@ -132,6 +135,104 @@ struct DriveBench {
     tick();
     EXPECT_EQ(state(), State::kOperationEnabled) << std::hex << statusword();
   }
+};
+
+// ---- through frames -------------------------------------------------------------------------
+
+struct ProcessDataSm {
+  unsigned sm{2};
+  bool outputs{true};
+  std::uint16_t length{0};
+};
+
+struct OpSlave {
+  std::uint16_t outBytes{0};  // outputs at logical 0 ...
+  std::uint16_t inBytes{0};   // ... inputs right after them
+  std::unique_ptr<MailboxMaster> mailbox;
+};
+
+// Brings segment slave 0 (station kStation) to OP with frames the way a master does: station
+// address, SII read through the EEPROM registers, mailbox SMs from the SII, INIT->PREOP,
+// `inPreOp` (SDO configuration), the given process-data SMs (start and control byte from the
+// SII) with one FMMU each (outputs first from logical 0, then inputs), PREOP->SAFEOP, one LRW,
+// SAFEOP->OP. All at time `now`.
+inline OpSlave bringToOp(topology::Segment& seg, const std::vector<ProcessDataSm>& sms,
+                         SimTime now = 0,
+                         const std::function<void(MailboxMaster&)>& inPreOp = nullptr) {
+  OpSlave out;
+  auto at = [&](Command c, std::uint32_t address, std::vector<std::uint8_t> data) {
+    return one(seg, c, address, std::move(data), now);
+  };
+  at(Command::kApwr, phys(0, reg::kConfiguredStationAddress.address), le16(kStation));
+  auto image = SiiImage::parseLenient(readSiiThroughFrames(seg, kStation));
+  EXPECT_TRUE(image.ok());
+  if (!image.ok()) return out;
+  const SiiContents& sii = image->contents();
+  const SiiMailbox& mbx = sii.standardMailbox;
+  if (mbx.receiveSize > 0) {
+    const std::uint16_t inSize = mbx.sendSize != 0 ? mbx.sendSize : mbx.receiveSize;
+    out.mailbox = std::make_unique<MailboxMaster>(seg, kStation, mbx.receiveOffset, mbx.receiveSize,
+                                                  mbx.sendOffset, inSize);
+    at(Command::kFpwr, phys(kStation, reg::smChannel(0)),
+       smRegisterBytes(mbx.receiveOffset, mbx.receiveSize, sii.syncManagers.at(0).control));
+    at(Command::kFpwr, phys(kStation, reg::smChannel(1)),
+       smRegisterBytes(mbx.sendOffset, inSize, sii.syncManagers.at(1).control));
+  }
+  at(Command::kFpwr, phys(kStation, reg::kAlControl.address), le16(0x0002));
+  EXPECT_EQ(readLe16(at(Command::kFprd, phys(kStation, reg::kAlStatus.address), {0, 0}).data, 0),
+            0x0002);
+  if (inPreOp && out.mailbox) inPreOp(*out.mailbox);
+  std::uint32_t logical = 0;
+  unsigned fmmu = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    for (const ProcessDataSm& pd : sms) {
+      if (pd.outputs != (pass == 0) || pd.length == 0) continue;
+      const auto& smInfo = sii.syncManagers.at(pd.sm);
+      at(Command::kFpwr, phys(kStation, reg::smChannel(pd.sm)),
+         smRegisterBytes(smInfo.startAddress, pd.length, smInfo.control));
+      at(Command::kFpwr, phys(kStation, reg::fmmuChannel(fmmu++)),
+         fmmuRegisterBytes(logical, pd.length, smInfo.startAddress, pd.outputs ? 2 : 1));
+      logical += pd.length;
+      (pd.outputs ? out.outBytes : out.inBytes) += pd.length;
+    }
+  }
+  at(Command::kFpwr, phys(kStation, reg::kAlControl.address), le16(0x0004));
+  EXPECT_EQ(readLe16(at(Command::kFprd, phys(kStation, reg::kAlStatus.address), {0, 0}).data, 0),
+            0x0004);
+  if (logical > 0) at(Command::kLrw, 0, std::vector<std::uint8_t>(logical, 0));
+  at(Command::kFpwr, phys(kStation, reg::kAlControl.address), le16(0x0008));
+  EXPECT_EQ(readLe16(at(Command::kFprd, phys(kStation, reg::kAlStatus.address), {0, 0}).data, 0),
+            0x0008);
+  return out;
+}
+
+// The cyclic exchange of one slave: each cycle runs the firmware at the cycle's time (the
+// device tick, where a SYNC0 event would sample the inputs) and then one LRW over outputs and
+// inputs.
+struct CyclicExchange {
+  topology::Segment& seg;
+  std::uint16_t outBytes{0};
+  std::uint16_t inBytes{0};
+  SimTime now{0};
+  std::vector<std::uint8_t> out = std::vector<std::uint8_t>(outBytes, 0);
+  std::vector<std::uint8_t> in = std::vector<std::uint8_t>(inBytes, 0);
+  std::uint16_t wkc{0};
+
+  void cycle(SimTime period = kNsPerMs) {
+    now += period;
+    seg.pollSlaves(now);
+    std::vector<std::uint8_t> image(out);
+    image.resize(outBytes + inBytes, 0);
+    auto r = one(seg, Command::kLrw, 0, image, now);
+    wkc = r.wkc;
+    in.assign(r.data.begin() + outBytes, r.data.end());
+  }
+  void put8(std::size_t at, std::uint8_t v) { out.at(at) = v; }
+  void put16(std::size_t at, std::uint16_t v) { writeLe16(out, at, v); }
+  void put32(std::size_t at, std::int32_t v) { writeLe32(out, at, static_cast<std::uint32_t>(v)); }
+  std::uint8_t in8(std::size_t at) const { return in.at(at); }
+  std::uint16_t in16(std::size_t at) const { return readLe16(in, at); }
+  std::int32_t in32(std::size_t at) const { return static_cast<std::int32_t>(readLe32(in, at)); }
 };
 
 }  // namespace ecsim::testing
