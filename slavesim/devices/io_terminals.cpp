@@ -170,9 +170,8 @@ Result<std::unique_ptr<AnalogInputTerminal>> AnalogInputTerminal::create(
 
 void AnalogInputTerminal::setScript(unsigned channel, Signal volts) {
   if (channel < 1 || channel > channels_.size()) return;
-  Channel& c = channels_[channel - 1];
-  c.script = std::move(volts);
-  c.primed = false;
+  // The filter keeps its state: a new script is a new signal at the same input.
+  channels_[channel - 1].script = std::move(volts);
 }
 
 void AnalogInputTerminal::clearScript(unsigned channel) {
