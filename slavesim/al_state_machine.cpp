@@ -48,8 +48,12 @@ std::uint16_t AlStateMachine::checkProcessData(const Esc& esc, const SlaveProfil
     auto c = esc.smConfig(pd.index);
     const bool write =
         (c.control & reg::sm::kControlDirectionMask) == reg::sm::kControlDirectionWrite;
-    const bool buffered = (c.control & reg::sm::kControlModeMask) == reg::sm::kControlModeBuffered;
-    if (!c.enabled || !buffered || write != pd.outputs || c.length != pd.length) {
+    // Process data may use a 3-buffer or a 1-buffer (mailbox-mode) SM: both are valid ESC
+    // configurations (some devices' ESI ask for 1-buffer, e.g. the EL9800 evaluation board).
+    const std::uint8_t mode = c.control & reg::sm::kControlModeMask;
+    const bool validMode =
+        mode == reg::sm::kControlModeBuffered || mode == reg::sm::kControlModeMailbox;
+    if (!c.enabled || !validMode || write != pd.outputs || c.length != pd.length) {
       return code(pd.outputs ? AlStatusCode::kInvalidOutputConfiguration
                              : AlStatusCode::kInvalidInputConfiguration);
     }

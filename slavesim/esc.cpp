@@ -467,6 +467,7 @@ bool Esc::writeRam(std::uint16_t address, ConstBytes data, int smIndex) {
     std::copy(data.begin(), data.end(), memory_.begin() + address);
     if (lastByte) {
       st.mailboxFull = true;
+      st.hasLatest = true;  // for 1-buffer process data: outputs received
       memory_[base + reg::sm::kStatus.address] |= reg::sm::kStatusMailboxFull;
       ++counters_.mailboxWrites;
       events_.mailboxReceived = true;
@@ -849,7 +850,9 @@ void Esc::pdiMailboxRepeat() {
 ConstBytes Esc::pdiOutputs(unsigned s) const {
   if (s >= type_.syncManagers) return {};
   auto c = smConfig(s);
-  if (!c.enabled || isMailbox(c.control) || !isEcatWrite(c.control) || c.length == 0) return {};
+  if (!c.enabled || !isEcatWrite(c.control) || c.length == 0) return {};
+  // 1-buffer (mailbox-mode) process data: the buffer is the memory itself.
+  if (isMailbox(c.control)) return ConstBytes(memory_.data() + c.start, c.length);
   const std::size_t bufBase = 3u * static_cast<std::size_t>(c.start);
   return ConstBytes(buffers_.data() + bufBase + sm_[s].latest * c.length, c.length);
 }
@@ -857,8 +860,17 @@ ConstBytes Esc::pdiOutputs(unsigned s) const {
 bool Esc::pdiWriteInputs(unsigned s, ConstBytes data) {
   if (s >= type_.syncManagers) return false;
   auto c = smConfig(s);
-  if (!c.enabled || isMailbox(c.control) || isEcatWrite(c.control) || c.length == 0) return false;
+  if (!c.enabled || isEcatWrite(c.control) || c.length == 0) return false;
   auto& st = sm_[s];
+  if (isMailbox(c.control)) {
+    // 1-buffer inputs: the PDI may write only when the master has read the last buffer.
+    if (st.mailboxFull) return false;
+    const std::size_t n1 = std::min<std::size_t>(data.size(), c.length);
+    std::copy_n(data.begin(), n1, memory_.begin() + c.start);
+    st.mailboxFull = true;
+    memory_[reg::smChannel(s) + reg::sm::kStatus.address] |= reg::sm::kStatusMailboxFull;
+    return true;
+  }
   const std::size_t bufBase = 3u * static_cast<std::size_t>(c.start);
   std::size_t n = std::min<std::size_t>(data.size(), c.length);
   std::copy_n(data.begin(), n,
@@ -870,6 +882,15 @@ bool Esc::pdiWriteInputs(unsigned s, ConstBytes data) {
   st.writing = next;
   st.hasLatest = true;
   return true;
+}
+
+void Esc::pdiReleaseBuffer(unsigned s) {
+  if (s >= type_.syncManagers) return;
+  auto c = smConfig(s);
+  if (!c.enabled || !isMailbox(c.control) || !isEcatWrite(c.control)) return;
+  sm_[s].mailboxFull = false;
+  memory_[reg::smChannel(s) + reg::sm::kStatus.address] &=
+      static_cast<std::uint8_t>(~reg::sm::kStatusMailboxFull);
 }
 
 void Esc::countRxError(unsigned port, bool invalidFrame) {

@@ -99,6 +99,9 @@ class Esc {
   // Process data: the newest complete buffer of an ECAT-write SM, and write a complete buffer
   // into an ECAT-read SM. Returns an empty span / false when the SM is not a buffered SM.
   ConstBytes pdiOutputs(unsigned sm) const;
+  // 1-buffer (mailbox-mode) process-data output SM: the firmware has taken the buffer, so the
+  // master may write the next one.
+  void pdiReleaseBuffer(unsigned sm);
   // True once the master completed at least one buffer of this output SM since it was enabled.
   bool pdiOutputsReceived(unsigned sm) const { return sm < sm_.size() && sm_[sm].hasLatest; }
   bool hasEvents() const {

@@ -30,6 +30,10 @@ void Slave::poll(SimTime now) {
   }
   if (mailbox_) mailbox_->poll(esc_, now);
   if (device_) device_->step(esc_, state(), now);
+  // 1-buffer process-data outputs: the device has taken them; free the buffer for the next.
+  for (const auto& pd : profile_.processData) {
+    if (pd.outputs && pd.length > 0) esc_.pdiReleaseBuffer(pd.index);
+  }
 }
 
 }  // namespace ecsim::slavesim

@@ -226,3 +226,49 @@ TEST_F(Memory, BadSiiChecksumKeepsPdiOff) {
 
 }  // namespace
 }  // namespace ecsim::testing
+
+namespace ecsim::testing {
+namespace {
+
+// Process data through 1-buffer (mailbox-mode) SMs, as some devices' ESI ask for (EL9800):
+// the master's write fills the buffer, the firmware takes it, inputs are read once per PDI
+// write.
+TEST(OneBufferProcessData, OutputsAndInputsFlowAndTheEsmAcceptsThem) {
+  slavesim::SlaveProfile p;
+  p.processData = {{2, true, 2}, {3, false, 2}};
+  topology::Segment seg;
+  seg.addSlave(makeSlave("io", 1, p));
+  one(seg, Command::kApwr, phys(0, 0x0010), le16(0x1001));
+  auto sm = [&](std::uint16_t reg, std::uint16_t start, std::uint8_t control) {
+    std::vector<std::uint8_t> b(8, 0);
+    writeLe16(b, 0, start);
+    writeLe16(b, 2, 2);
+    b[4] = control;
+    b[6] = 1;
+    one(seg, Command::kFpwr, phys(0x1001, reg), b);
+  };
+  sm(0x0810, 0x1100, 0x26);  // outputs, 1-buffer
+  sm(0x0818, 0x1180, 0x22);  // inputs, 1-buffer
+  auto& esc = seg.slave(0).esc();
+  one(seg, Command::kFpwr, phys(0x1001, 0x0120), le16(0x0002));
+  one(seg, Command::kFpwr, phys(0x1001, 0x0120), le16(0x0004));
+  ASSERT_EQ(esc.alStatus(), 0x0004) << "PREOP -> SAFEOP with 1-buffer SMs";
+  EXPECT_EQ(one(seg, Command::kFpwr, phys(0x1001, 0x1100), {0x12, 0x34}).wkc, 1);
+  auto out = esc.pdiOutputs(2);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_EQ(out[1], 0x34);
+  EXPECT_EQ(one(seg, Command::kFpwr, phys(0x1001, 0x1100), {0x56, 0x78}).wkc, 1)
+      << "the firmware took the first buffer, so the next write is accepted";
+  ASSERT_TRUE(esc.pdiWriteInputs(3, std::vector<std::uint8_t>{0xAB, 0xCD}));
+  EXPECT_FALSE(esc.pdiWriteInputs(3, std::vector<std::uint8_t>{0, 0})) << "not read yet";
+  auto in = one(seg, Command::kFprd, phys(0x1001, 0x1180), {0, 0});
+  EXPECT_EQ(in.wkc, 1);
+  EXPECT_EQ(in.data, (std::vector<std::uint8_t>{0xAB, 0xCD}));
+  EXPECT_EQ(one(seg, Command::kFprd, phys(0x1001, 0x1180), {0, 0}).wkc, 0)
+      << "read once: empty until the PDI writes again";
+  one(seg, Command::kFpwr, phys(0x1001, 0x0120), le16(0x0008));
+  EXPECT_EQ(esc.alStatus(), 0x0008);
+}
+
+}  // namespace
+}  // namespace ecsim::testing
