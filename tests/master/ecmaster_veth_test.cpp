@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "link/netns.hpp"
+#include "support/privileges.hpp"
 #include "support/test_network.hpp"
 
 namespace ecsim::testing {
@@ -12,14 +13,6 @@ namespace {
 
 const std::string kEcmaster = std::string(ECSIM_BINARY_DIR) + "/tools/ecmaster/ecmaster";
 const std::string kEcsim = std::string(ECSIM_BINARY_DIR) + "/tools/ecsim/ecsim";
-
-#define ECSIM_REQUIRE_NETWORK()                                               \
-  do {                                                                        \
-    if (auto caps = checkNetworkCapabilities(); !caps.ok()) {                 \
-      if (ciMode()) FAIL() << "CI=true and " << caps.error().message();       \
-      GTEST_SKIP() << "needs network privileges: " << caps.error().message(); \
-    }                                                                         \
-  } while (false)
 
 TEST(EcmasterVeth, ScanSdoAndCyclicOverARawSocket) {
   ECSIM_REQUIRE_NETWORK();

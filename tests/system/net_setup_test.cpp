@@ -8,20 +8,13 @@
 #include <thread>
 
 #include "link/netns.hpp"
+#include "support/privileges.hpp"
 #include "support/test_network.hpp"
 
 namespace ecsim::testing {
 namespace {
 
 const std::string kEcsim = std::string(ECSIM_BINARY_DIR) + "/tools/ecsim/ecsim";
-
-#define ECSIM_REQUIRE_NETWORK()                                               \
-  do {                                                                        \
-    if (auto caps = checkNetworkCapabilities(); !caps.ok()) {                 \
-      if (ciMode()) FAIL() << "CI=true and " << caps.error().message();       \
-      GTEST_SKIP() << "needs network privileges: " << caps.error().message(); \
-    }                                                                         \
-  } while (false)
 
 bool linkExists(const VethNamespace& ns, const std::string& ifname) {
   auto out = ns.run({"ip", "link", "show", ifname});

@@ -16,20 +16,13 @@
 #include "link/netns.hpp"
 #include "link/raw_socket_link.hpp"
 #include "protocol/frame.hpp"
+#include "support/privileges.hpp"
 #include "support/test_network.hpp"
 
 namespace ecsim::testing {
 namespace {
 
 const std::string kEcsim = std::string(ECSIM_BINARY_DIR) + "/tools/ecsim/ecsim";
-
-#define ECSIM_REQUIRE_NETWORK()                                               \
-  do {                                                                        \
-    if (auto caps = checkNetworkCapabilities(); !caps.ok()) {                 \
-      if (ciMode()) FAIL() << "CI=true and " << caps.error().message();       \
-      GTEST_SKIP() << "needs network privileges: " << caps.error().message(); \
-    }                                                                         \
-  } while (false)
 
 std::string readText(const std::string& path) {
   std::ifstream in(path);
