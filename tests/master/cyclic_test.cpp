@@ -26,7 +26,12 @@ void* operator new(std::size_t size) {
 void* operator new[](std::size_t size) {
   return ::operator new(size);
 }
-// The library's operator delete frees with free(), which matches the malloc above.
+// Deletes must match the malloc above, also under AddressSanitizer (whose own operator delete
+// would report an alloc-dealloc mismatch): free() for every replaced form.
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 
 namespace ecsim::testing {
 namespace {
