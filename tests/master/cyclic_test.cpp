@@ -26,8 +26,16 @@ void* operator new(std::size_t size) {
 void* operator new[](std::size_t size) {
   return ::operator new(size);
 }
-// Deletes must match the malloc above, also under AddressSanitizer (whose own operator delete
-// would report an alloc-dealloc mismatch): free() for every replaced form.
+void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
+  if (gCounting.load(std::memory_order_relaxed)) gAllocations.fetch_add(1);
+  return std::malloc(size == 0 ? 1 : size);
+}
+void* operator new[](std::size_t size, const std::nothrow_t& tag) noexcept {
+  return ::operator new(size, tag);
+}
+// Every non-aligned form of new and delete is replaced, so that allocation and release always
+// pair malloc with free, also under AddressSanitizer (which reports any mismatch). Aligned
+// forms stay the library's, which pair among themselves.
 // (g++ cannot see that the replaced operator new above mallocs, hence the pragma.)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmismatched-new-delete"
