@@ -50,10 +50,12 @@ void DcClock::rebase(SimTime global) {
 
 std::int64_t DcClock::onSystemTimeWrite(SimTime global, SimTime localSystemTime, SimTime received,
                                         unsigned filterDepth) {
-  const std::int64_t diff = localSystemTime - received;
+  // System time is a 64-bit counter: the difference wraps (and a master may write anything).
+  const auto diff = static_cast<std::int64_t>(static_cast<std::uint64_t>(localSystemTime) -
+                                              static_cast<std::uint64_t>(received));
   // The first write after a reset, or a difference beyond what drift can explain (an offset
   // not yet compensated), only measures: no frequency is learnt from it.
-  if (!haveLastWrite_ || global <= lastWrite_ || std::llabs(diff) > 10'000'000) {
+  if (!haveLastWrite_ || global <= lastWrite_ || (diff > 10'000'000 || diff < -10'000'000)) {
     haveLastWrite_ = true;
     lastWrite_ = global;
     return diff;

@@ -8,6 +8,11 @@ namespace {
 
 constexpr std::uint16_t kRamStart = reg::kRegisterSpaceEnd;
 
+// DC system time is a 64-bit counter that wraps; offsets come from the master unchecked.
+SimTime wrapAdd(SimTime a, std::uint64_t b) {
+  return static_cast<SimTime>(static_cast<std::uint64_t>(a) + b);
+}
+
 // The SII words the ESC loads into registers at power-on (datasheet section I §11.1).
 constexpr std::size_t kSiiPdiControlWord = 0x00;
 constexpr std::size_t kSiiPdiConfigWord = 0x01;
@@ -175,7 +180,7 @@ void Esc::loadFromSii() {
 // ---- ECAT side ------------------------------------------------------------------------------
 
 SimTime Esc::systemTime(SimTime time) const {
-  return dc_.localTime(time) + static_cast<SimTime>(reg64(reg::kSystemTimeOffset.address));
+  return wrapAdd(dc_.localTime(time), reg64(reg::kSystemTimeOffset.address));
 }
 
 void Esc::processDatagram(DatagramView d, SimTime time) {
@@ -575,7 +580,7 @@ bool Esc::writeRegisters(std::uint16_t address, ConstBytes data) {
     // Written system time is compared with the local copy; the difference feeds the drift
     // control loop (datasheet section I §9.1.3). A 32-bit write compares the low 32 bits.
     // 0x092C: bit 31 set = local copy smaller than the received time.
-    const SimTime local = localNow_ + static_cast<SimTime>(reg64(reg::kSystemTimeOffset.address));
+    const SimTime local = wrapAdd(localNow_, reg64(reg::kSystemTimeOffset.address));
     std::uint64_t written = static_cast<std::uint64_t>(local);
     for (std::uint32_t i = 0; i < 8; ++i) {
       std::uint32_t a = reg::kSystemTime.address + i;
@@ -585,7 +590,7 @@ bool Esc::writeRegisters(std::uint16_t address, ConstBytes data) {
       }
     }
     const SimTime received =
-        static_cast<SimTime>(written) + static_cast<SimTime>(reg32(reg::kSystemTimeDelay.address));
+        wrapAdd(static_cast<SimTime>(written), reg32(reg::kSystemTimeDelay.address));
     const std::int64_t diff = dc_.onSystemTimeWrite(
         now_, local, received, memory_[reg::kSystemTimeDifferenceFilterDepth.address] & 0x0F);
     const std::uint32_t mag =
@@ -624,8 +629,9 @@ void Esc::smActivationChanged(unsigned s) {
 
 void Esc::refreshVolatile(std::uint16_t begin, std::uint16_t end) {
   if (overlaps(begin, end, reg::kSystemTime.address, reg::kSystemTime.width)) {
-    auto offset = static_cast<std::int64_t>(reg64(reg::kSystemTimeOffset.address));
-    writeLe64(memory_, reg::kSystemTime.address, static_cast<std::uint64_t>(localNow_ + offset));
+    writeLe64(
+        memory_, reg::kSystemTime.address,
+        static_cast<std::uint64_t>(wrapAdd(localNow_, reg64(reg::kSystemTimeOffset.address))));
   }
 }
 
