@@ -78,6 +78,13 @@ class Esc {
   const DcClock& dcClock() const { return dc_; }
   // System time (0x0910 as a read would give it) at simulation time `time`.
   SimTime systemTime(SimTime time) const;
+  // True while the sync unit generates SYNC0 (signal 0) or SYNC1 (signal 1) pulses: cyclic
+  // unit assigned to ECAT or PDI, activation 0x0981 bit 0 and the signal's enable bit set.
+  bool syncActive(unsigned signal) const {
+    const std::uint8_t act = reg8(reg::kDcActivation.address);
+    return dcUnit_ == DcUnit::kFull && (act & 0x01) != 0 &&
+           (act & (signal == 0 ? 0x02 : 0x04)) != 0;
+  }
 
   // ---- PDI side (firmware) --------------------------------------------------------------
   std::uint16_t alControl() const { return reg16(reg::kAlControl.address); }

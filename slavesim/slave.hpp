@@ -30,6 +30,11 @@ class Device {
   virtual void updateProfile(SlaveProfile& /*profile*/) {}
   // Called after an AL state change and periodically; exchanges process data with the ESC.
   virtual void step(Esc& /*esc*/, AlState /*state*/, SimTime /*now*/) {}
+  // A pulse of the DC sync unit: SYNC0 (signal 0) or SYNC1 (signal 1), at simulation time
+  // `now` (the pulse's start; pulses since the last poll are delivered in order). While
+  // Esc::syncActive(0) holds, a device synchronised to DC steps its model and latches its
+  // inputs here rather than in step() (ETG.1020 DC synchronous mode, 0x1C32:01 = 2).
+  virtual void sync(Esc& /*esc*/, unsigned /*signal*/, AlState /*state*/, SimTime /*now*/) {}
 };
 
 class Slave {
