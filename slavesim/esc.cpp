@@ -906,6 +906,12 @@ void Esc::countRxError(unsigned port, bool invalidFrame) {
   if (memory_[at] < 0xFF) ++memory_[at];
 }
 
+void Esc::countForwardedRxError(unsigned port) {
+  if (port > 3) return;
+  std::uint16_t at = reg::forwardedRxErrorCounter(port);
+  if (memory_[at] < 0xFF) ++memory_[at];
+}
+
 void Esc::countLostLink(unsigned port) {
   if (port > 3) return;
   std::uint16_t at = reg::lostLinkCounter(port);

@@ -172,9 +172,16 @@ class Esc {
   // Error counters (0x0300-0x0313), saturating at 0xFF as the datasheet specifies.
   void countRxError(unsigned port, bool invalidFrame);
   void countLostLink(unsigned port);
+  // A frame already marked bad by an earlier ESC arrived at `port` (0x0308 + port).
+  void countForwardedRxError(unsigned port);
 
   // The SII EEPROM content (words), e.g. for persisting writes or inspecting.
   const std::vector<std::uint8_t>& sii() const { return sii_; }
+  // Changes one byte of the EEPROM from outside (fault injection); takes effect at the next
+  // reload or power-on reset, as on hardware.
+  void writeSiiByte(std::size_t offset, std::uint8_t value) {
+    if (offset < sii_.size()) sii_[offset] = value;
+  }
 
   // Power cycle: registers back to reset values, EEPROM content kept, reloaded.
   void powerOnReset();

@@ -9,8 +9,15 @@ Slave::Slave(std::string name, const EscType& type, std::vector<std::uint8_t> si
       profile_(std::move(profile)),
       mailboxBuffer_(static_cast<std::size_t>(type.ramKb) * 1024) {}
 
+void Slave::powerOn() {
+  esc_.powerOnReset();
+  powered_ = true;
+  firmwareRunning_ = (esc_.reg16(reg::kDlStatus.address) & reg::dl_status::kPdiOperational) != 0;
+}
+
 void Slave::poll(SimTime now) {
   EscEvents events = esc_.takeEvents();
+  if (!powered_ || !firmwareRunning_) return;
   if (events.alControlWritten) {
     if (device_) device_->updateProfile(profile_);
     esm_.onAlControl(esc_, profile_);

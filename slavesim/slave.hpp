@@ -50,12 +50,24 @@ class Slave {
   void setMailboxServer(std::unique_ptr<MailboxServer> server) { mailbox_ = std::move(server); }
   void setDevice(std::unique_ptr<Device> device) { device_ = std::move(device); }
   MailboxServer* mailboxServer() { return mailbox_.get(); }
+  // Hands the mailbox server over (to wrap it, e.g. for fault injection).
+  std::unique_ptr<MailboxServer> takeMailboxServer() { return std::move(mailbox_); }
   Device* device() { return device_.get(); }
 
   // Runs the firmware: reacts to ESC events (AL control, mailbox) and steps the device.
   void poll(SimTime now);
 
   AlStateMachine& stateMachine() { return esm_; }
+
+  // Power. Off: the firmware stops (the topology breaks the links at the neighbours' ports).
+  // On: a power-on reset of the ESC (registers and AL state; the EEPROM content is kept); the
+  // firmware runs again only when the ESC loaded its EEPROM configuration (PDI operational),
+  // so a slave with an EEPROM checksum error stays in INIT. Device models keep their state:
+  // whoever owns them re-creates them for a cold start.
+  void powerOff() { powered_ = false; }
+  void powerOn();
+  bool powered() const { return powered_; }
+  bool firmwareRunning() const { return powered_ && firmwareRunning_; }
 
  private:
   std::string name_;
@@ -65,6 +77,8 @@ class Slave {
   std::unique_ptr<MailboxServer> mailbox_;
   std::unique_ptr<Device> device_;
   std::vector<std::uint8_t> mailboxBuffer_;
+  bool powered_{true};
+  bool firmwareRunning_{true};
 };
 
 }  // namespace ecsim::slavesim

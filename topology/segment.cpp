@@ -149,6 +149,8 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
   std::uint8_t k = 0;
   notify(0, 0, frame, sendTime, true);
   SimTime t = sendTime + cableDelay(masterCable_);
+  bool bad = false;  // corrupted on the way (fault injection): counted, never executed
+  if (faults_ != nullptr) arriveWithFaults(0, 0, t, bad);
   stack_.push_back({0, 0, 0});
   arrival_[0][0] = t;
   arrivalMask_[0] = 1;
@@ -160,7 +162,7 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
     if (k == 0) {
       auto& esc = slaves_[s]->esc();
       esc.beginFrame();
-      for (std::size_t i = 0; i < count; ++i) {
+      for (std::size_t i = 0; i < (bad ? 0 : count); ++i) {
         SimTime at = t + headerLead + static_cast<SimTime>(offsets[i]) * nsPerByte;
         esc.processDatagram(datagrams_[i], at);
       }
@@ -200,6 +202,7 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
       k = l.port;
       t = tOut + cableDelay(l.cableMetres);
     }
+    if (faults_ != nullptr) arriveWithFaults(s, k, t, bad);
     arrival_[s][k] = t;
     arrivalMask_[s] = static_cast<std::uint8_t>(arrivalMask_[s] | (1u << k));
   }
@@ -213,9 +216,23 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
   // (preamble + SFD + frame + FCS).
   const SimTime frameTime =
       static_cast<SimTime>(8 + std::max<std::size_t>(frame.size(), kMinFrameSize) + 4) * nsPerByte;
-  outcome.delivered = true;
+  outcome.delivered = !bad;
   outcome.returnTime = sendTime + outcome.firstBitRoundTrip + frameTime;
   return outcome;
+}
+
+bool Segment::arriveWithFaults(std::size_t s, unsigned port, SimTime& t, bool& bad) {
+  t += faults_->extraDelay(s, port, t);
+  auto& esc = slaves_[s]->esc();
+  if (bad) {
+    // An ESC forwarding a frame with a bad FCS marks it; the next ESCs count a forwarded
+    // error rather than an invalid frame (ESC datasheet section I §7.2, 0x0308-0x030B).
+    esc.countForwardedRxError(port);
+  } else if (faults_->corrupts(s, port, t)) {
+    esc.countRxError(port, true);
+    bad = true;
+  }
+  return !bad;
 }
 
 void Segment::pollSlaves(SimTime now) {

@@ -47,6 +47,18 @@ class CableObserver {
   virtual void onFrame(ConstBytes frame, SimTime time, bool downstream) = 0;
 };
 
+// Faults on the wire (topology/faults.hpp), consulted while installed with setWireFaults().
+// A frame arriving at `slave`'s port `port` (it has just crossed the cable ending there, in
+// either direction) may be corrupted there: that ESC counts an invalid frame, every later ESC
+// a forwarded error, no datagram is executed from then on and the master gets nothing.
+class WireFaults {
+ public:
+  virtual ~WireFaults() = default;
+  virtual bool corrupts(std::size_t slave, unsigned port, SimTime time) = 0;
+  // Extra time the cable ending at (slave, port) takes now (delay spikes).
+  virtual SimTime extraDelay(std::size_t slave, unsigned port, SimTime time) = 0;
+};
+
 struct FrameOutcome {
   bool delivered{false};  // false: dropped (malformed or lost)
   SimTime returnTime{0};  // when the last bit is back at the master
@@ -99,6 +111,9 @@ class Segment {
   // Opens or closes a port (a pulled cable closes both ends' links).
   void setLinkUp(std::size_t slave, unsigned port, bool up);
 
+  // Installs (nullptr: removes) the wire faults; the caller keeps them alive.
+  void setWireFaults(WireFaults* faults) { faults_ = faults; }
+
   const SegmentCounters& counters() const { return counters_; }
   const TimingModel& timing() const { return timing_; }
   void setTiming(const TimingModel& t) { timing_ = t; }
@@ -128,6 +143,10 @@ class Segment {
   double masterCable_{1.0};
   TimingModel timing_{};
   SegmentCounters counters_{};
+  WireFaults* faults_{nullptr};
+  // With faults installed: the frame has arrived at (s, port) at time t (adds any extra delay
+  // to t); returns false once it is corrupted (counted in the ESCs' error counters).
+  bool arriveWithFaults(std::size_t s, unsigned port, SimTime& t, bool& bad);
   // Scratch for the datagram views of the frame in flight (no allocation per frame).
   std::array<DatagramView, 128> datagrams_{};
   struct Visit {

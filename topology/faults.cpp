@@ -1,0 +1,477 @@
+#include "topology/faults.hpp"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+
+#include "protocol/al_status.hpp"
+#include "protocol/mailbox.hpp"
+#include "protocol/sdo.hpp"
+#include "slavesim/devices/device_models.hpp"
+#include "slavesim/devices/signal.hpp"
+#include "slavesim/process_data.hpp"
+
+namespace ecsim::topology {
+namespace {
+
+constexpr std::size_t kSiiChecksumByte = 14;  // word 7, low byte: CRC-8 of words 0-6
+constexpr std::uint16_t kOvercurrent = 0x2310;
+constexpr std::uint16_t kPositionSensorFault = 0x7305;
+
+constexpr std::array<std::string_view, 17> kVerbs{
+    "loss",        "corrupt",       "delay",           "link-down",      "link-up",   "power-off",
+    "power-on",    "al-error",      "eeprom-checksum", "mailbox-silent", "sdo-abort", "sdo-ok",
+    "drive-fault", "encoder-fault", "input",           "power-cycle",    "mailbox-ok"};
+
+std::optional<AlState> stateFromName(std::string_view name) {
+  if (name == "INIT") return AlState::kInit;
+  if (name == "PREOP") return AlState::kPreOp;
+  if (name == "BOOT") return AlState::kBootstrap;
+  if (name == "SAFEOP") return AlState::kSafeOp;
+  if (name == "OP") return AlState::kOp;
+  return std::nullopt;
+}
+
+// Wraps a slave's mailbox server: silent (requests swallowed, nothing answered) or aborting
+// SDO requests for chosen objects with a chosen code; everything else goes to the real server.
+class FaultyMailbox final : public slavesim::MailboxServer {
+ public:
+  explicit FaultyMailbox(std::unique_ptr<slavesim::MailboxServer> inner)
+      : inner_(std::move(inner)) {}
+
+  void onRequest(slavesim::Esc& esc, ConstBytes mailbox, SimTime now) override {
+    if (silent) return;
+    if (auto abort = matchAbort(mailbox)) {
+      std::array<std::uint8_t, 64> out{};
+      MailboxHeader header;
+      if (auto h = MailboxHeader::decode(mailbox); h.ok()) header.counter = h->counter;
+      if (auto n = encodeSdoResponseMailbox(out, SdoResponse{*abort}, header); n.ok()) {
+        (void)esc.pdiMailboxSend(ConstBytes(out.data(), *n));
+      }
+      return;
+    }
+    if (inner_) inner_->onRequest(esc, mailbox, now);
+  }
+  void poll(slavesim::Esc& esc, SimTime now) override {
+    if (!silent && inner_) inner_->poll(esc, now);
+  }
+
+  struct Rule {
+    std::uint16_t index{0};
+    std::optional<std::uint8_t> subindex;
+    std::uint32_t code{0};
+  };
+  bool silent{false};
+  std::vector<Rule> aborts;
+
+ private:
+  std::optional<SdoAbort> matchAbort(ConstBytes mailbox) const {
+    if (aborts.empty()) return std::nullopt;
+    auto request = decodeSdoRequestMailbox(mailbox);
+    if (!request.ok()) return std::nullopt;
+    std::uint16_t index = 0;
+    std::uint8_t sub = 0;
+    if (const auto* up = std::get_if<SdoInitiateUploadRequest>(&request->sdo)) {
+      index = up->index;
+      sub = up->subindex;
+    } else if (const auto* down = std::get_if<SdoInitiateDownloadRequest>(&request->sdo)) {
+      index = down->index;
+      sub = down->subindex;
+    } else {
+      return std::nullopt;
+    }
+    for (const auto& r : aborts) {
+      if (r.index == index && (!r.subindex || *r.subindex == sub)) {
+        return SdoAbort{index, sub, r.code};
+      }
+    }
+    return std::nullopt;
+  }
+
+  std::unique_ptr<slavesim::MailboxServer> inner_;
+};
+
+FaultyMailbox& faultyMailbox(slavesim::Slave& slave) {
+  if (auto* f = dynamic_cast<FaultyMailbox*>(slave.mailboxServer())) return *f;
+  auto wrapper = std::make_unique<FaultyMailbox>(slave.takeMailboxServer());
+  FaultyMailbox& ref = *wrapper;
+  slave.setMailboxServer(std::move(wrapper));
+  return ref;
+}
+
+}  // namespace
+
+// ---- FaultAction ----------------------------------------------------------------------------
+
+std::optional<std::uint64_t> parseNumber(std::string_view text) {
+  int base = 10;
+  if (text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X')) {
+    text.remove_prefix(2);
+    base = 16;
+  }
+  std::uint64_t v = 0;
+  auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v, base);
+  if (ec != std::errc() || end != text.data() + text.size() || text.empty()) return std::nullopt;
+  return v;
+}
+
+std::optional<std::string_view> FaultAction::get(std::string_view key) const {
+  auto it = args.find(key);
+  if (it == args.end()) return std::nullopt;
+  return std::string_view(it->second);
+}
+
+Error FaultAction::error(std::string_view message) const {
+  return makeError(ErrorCode::kInvalidArgument, (where.empty() ? std::string() : where + ": ") +
+                                                    verb + ": " + std::string(message));
+}
+
+Result<std::string_view> FaultAction::require(std::string_view key) const {
+  if (auto v = get(key)) return *v;
+  return error("missing argument '" + std::string(key) + "'");
+}
+
+Result<std::uint64_t> FaultAction::number(std::string_view key) const {
+  ECSIM_ASSIGN_OR_RETURN(auto text, require(key));
+  if (auto v = parseNumber(text)) return *v;
+  return error("argument " + std::string(key) + "='" + std::string(text) + "' is not a number");
+}
+
+Result<std::uint64_t> FaultAction::number(std::string_view key, std::uint64_t fallback) const {
+  if (!get(key)) return fallback;
+  return number(key);
+}
+
+Result<double> FaultAction::real(std::string_view key) const {
+  ECSIM_ASSIGN_OR_RETURN(auto text, require(key));
+  double v = 0;
+  auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec != std::errc() || end != text.data() + text.size()) {
+    return error("argument " + std::string(key) + "='" + std::string(text) + "' is not a number");
+  }
+  return v;
+}
+
+std::string FaultAction::text() const {
+  std::string out = verb;
+  for (const auto& [k, v] : args) {
+    const bool quote = v.find(' ') != std::string::npos || v.empty();
+    out += " " + k + "=" + (quote ? "\"" + v + "\"" : v);
+  }
+  return out;
+}
+
+Result<FaultAction> parseFaultAction(std::string_view line) {
+  FaultAction action;
+  action.where = "control";
+  std::size_t i = 0;
+  auto skipSpace = [&] {
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
+  };
+  skipSpace();
+  std::size_t start = i;
+  while (i < line.size() && line[i] != ' ' && line[i] != '\t') ++i;
+  action.verb = std::string(line.substr(start, i - start));
+  if (action.verb.empty()) return makeError(ErrorCode::kParse, "control: empty action");
+  while (true) {
+    skipSpace();
+    if (i >= line.size()) break;
+    start = i;
+    while (i < line.size() && line[i] != '=' && line[i] != ' ') ++i;
+    if (i >= line.size() || line[i] != '=') {
+      return makeError(ErrorCode::kParse,
+                       fmt::format("control: column {}: expected key=value", start + 1));
+    }
+    std::string key(line.substr(start, i - start));
+    ++i;
+    std::string value;
+    if (i < line.size() && line[i] == '"') {
+      const std::size_t close = line.find('"', i + 1);
+      if (close == std::string_view::npos) {
+        return makeError(ErrorCode::kParse,
+                         fmt::format("control: column {}: unterminated quote", i + 1));
+      }
+      value = std::string(line.substr(i + 1, close - i - 1));
+      i = close + 1;
+    } else {
+      start = i;
+      while (i < line.size() && line[i] != ' ' && line[i] != '\t' && line[i] != '\r') ++i;
+      value = std::string(line.substr(start, i - start));
+    }
+    action.args[key] = value;
+  }
+  return action;
+}
+
+// ---- FaultInjector --------------------------------------------------------------------------
+
+FaultInjector::FaultInjector(Network& network, std::uint64_t seed)
+    : network_(network), segment_(*network.segment), random_(seed) {
+  segment_.setWireFaults(this);
+}
+
+FaultInjector::~FaultInjector() {
+  segment_.setWireFaults(nullptr);
+}
+
+bool FaultInjector::handles(std::string_view verb) {
+  return std::find(kVerbs.begin(), kVerbs.end(), verb) != kVerbs.end();
+}
+
+Result<std::size_t> FaultInjector::slaveIndex(std::string_view name) const {
+  for (std::size_t i = 0; i < segment_.size(); ++i) {
+    if (segment_.slave(i).name() == name) return i;
+  }
+  return makeError(ErrorCode::kNotFound, "no slave named '" + std::string(name) + "'");
+}
+
+std::optional<FaultInjector::End> FaultInjector::peer(End end) const {
+  const PortLink& l = segment_.ports(end.slave)[end.port];
+  if (l.slave == kNoSlave) return std::nullopt;
+  return End{static_cast<std::size_t>(l.slave), l.port};
+}
+
+Result<FaultInjector::End> FaultInjector::cableEnd(const FaultAction& action) const {
+  if (auto name = action.get("cable")) {
+    const CableRef* c = network_.findCable(*name);
+    if (c == nullptr) return action.error("no cable named '" + std::string(*name) + "'");
+    return End{c->slave, c->port};
+  }
+  if (auto slave = action.get("slave")) {
+    auto s = slaveIndex(*slave);
+    if (!s.ok()) return action.error(s.error().context);
+    ECSIM_ASSIGN_OR_RETURN(auto port, action.number("port"));
+    if (port >= kPortCount) return action.error("port must be 0..3");
+    return End{*s, static_cast<unsigned>(port)};
+  }
+  return action.error("needs cable=NAME or slave=NAME port=N");
+}
+
+void FaultInjector::setCable(End end, bool up) {
+  segment_.setLinkUp(end.slave, end.port, up);
+  if (auto p = peer(end)) segment_.setLinkUp(p->slave, p->port, up);
+}
+
+bool FaultInjector::corrupts(std::size_t slave, unsigned port, SimTime /*time*/) {
+  if (!anyWireFault_) return false;
+  const End end{slave, port};
+  if (auto it = corruptCount_.find(end); it != corruptCount_.end()) {
+    if (--it->second == 0) corruptCount_.erase(it);
+    refreshAny();
+    ++framesCorrupted_;
+    return true;
+  }
+  if (auto it = lossRate_.find(end); it != lossRate_.end() && random_.uniform() < it->second) {
+    ++framesCorrupted_;
+    return true;
+  }
+  return false;
+}
+
+SimTime FaultInjector::extraDelay(std::size_t slave, unsigned port, SimTime time) {
+  if (spikes_.empty()) return 0;
+  SimTime extra = 0;
+  for (const auto& s : spikes_) {
+    if (time >= s.until) continue;
+    if ((s.end.slave == slave && s.end.port == port) ||
+        (peer(s.end) && peer(s.end)->slave == slave && peer(s.end)->port == port)) {
+      extra += s.extra;
+    }
+  }
+  return extra;
+}
+
+Result<std::string> FaultInjector::powerOff(std::size_t s) {
+  auto& slave = segment_.slave(s);
+  if (!slave.powered()) return std::string(slave.name() + " is already off");
+  slave.powerOff();
+  poweredOff_.insert(s);
+  for (unsigned p = 0; p < kPortCount; ++p) {
+    if (s == 0 && p == 0) {
+      segment_.setLinkUp(0, 0, false);
+    } else if (auto other = peer({s, p})) {
+      segment_.setLinkUp(other->slave, other->port, false);
+    }
+  }
+  return slave.name() + " powered off";
+}
+
+Result<std::string> FaultInjector::powerOn(std::size_t s) {
+  auto& slave = segment_.slave(s);
+  slave.powerOn();
+  poweredOff_.erase(s);
+  // A cold start of the device model: a drive saves its encoder state file and its successor
+  // reads it (slavesim/devices/device_models.hpp).
+  if (auto* pdd = dynamic_cast<slavesim::ProcessDataDevice*>(slave.device())) {
+    if (auto* drive = slavesim::devices::driveOf(slave)) {
+      slavesim::devices::DeviceModelOptions options;
+      options.drive = drive->params();
+      options.stateFile = drive->params().stateFile;
+      const auto kind = slavesim::devices::robotDriveOf(slave) != nullptr
+                            ? slavesim::devices::DeviceModelKind::kRobotDrive
+                            : slavesim::devices::DeviceModelKind::kCia402Drive;
+      if (auto st = slavesim::devices::attachDeviceModel(*pdd, kind, options); !st.ok()) {
+        return makeError(ErrorCode::kState,
+                         slave.name() + ": drive restart: " + st.error().context);
+      }
+    }
+  }
+  for (unsigned p = 0; p < kPortCount; ++p) {
+    const End end{s, p};
+    std::optional<End> other = (s == 0 && p == 0) ? std::optional<End>() : peer(end);
+    const bool cut = cablesDown_.count(end) > 0 || (other && cablesDown_.count(*other) > 0) ||
+                     (other && poweredOff_.count(other->slave) > 0);
+    if (cut) continue;
+    if (s == 0 && p == 0) segment_.setLinkUp(0, 0, true);
+    if (other) {
+      segment_.setLinkUp(other->slave, other->port, true);
+      segment_.setLinkUp(s, p, true);
+    }
+  }
+  segment_.refreshLinkStatus();
+  const bool running = slave.firmwareRunning();
+  return slave.name() + " powered on" +
+         (running ? std::string() : std::string(" (EEPROM not loaded: PDI not operational)"));
+}
+
+Result<std::string> FaultInjector::apply(const FaultAction& a, SimTime now) {
+  const std::string& v = a.verb;
+  if (v == "loss") {
+    ECSIM_ASSIGN_OR_RETURN(auto rate, a.real("rate"));
+    if (rate < 0 || rate > 1) return a.error("rate must be within 0..1");
+    End end{0, 0};
+    if (a.get("cable")) {
+      ECSIM_ASSIGN_OR_RETURN(end, cableEnd(a));
+    }
+    if (rate == 0)
+      lossRate_.erase(end);
+    else
+      lossRate_[end] = rate;
+    refreshAny();
+    return fmt::format("frame loss {:.4f} at slave {} port {}", rate, end.slave, end.port);
+  }
+  if (v == "corrupt") {
+    ECSIM_ASSIGN_OR_RETURN(auto end, cableEnd(a));
+    ECSIM_ASSIGN_OR_RETURN(auto count, a.number("count", 1));
+    if (count > 0) corruptCount_[end] += count;
+    refreshAny();
+    return fmt::format("{} frame(s) corrupted entering {} port {}", count,
+                       segment_.slave(end.slave).name(), end.port);
+  }
+  if (v == "delay") {
+    ECSIM_ASSIGN_OR_RETURN(auto end, cableEnd(a));
+    ECSIM_ASSIGN_OR_RETURN(auto ns, a.number("ns"));
+    ECSIM_ASSIGN_OR_RETURN(auto ms, a.real("durationMs"));
+    spikes_.erase(std::remove_if(spikes_.begin(), spikes_.end(),
+                                 [&](const Spike& s) { return s.until <= now; }),
+                  spikes_.end());
+    spikes_.push_back(
+        {end, static_cast<SimTime>(ns), now + static_cast<SimTime>(ms * kNsPerMs + 0.5)});
+    refreshAny();
+    return fmt::format("cable delay +{} ns for {} ms", ns, ms);
+  }
+  if (v == "link-down" || v == "link-up") {
+    ECSIM_ASSIGN_OR_RETURN(auto end, cableEnd(a));
+    const bool up = v == "link-up";
+    if (up) {
+      cablesDown_.erase(end);
+      if (auto p = peer(end)) cablesDown_.erase(*p);
+    } else {
+      cablesDown_.insert(end);
+    }
+    setCable(end, up);
+    return fmt::format("link {} at {} port {}", up ? "up" : "down",
+                       segment_.slave(end.slave).name(), end.port);
+  }
+  if (v == "input") {
+    ECSIM_ASSIGN_OR_RETURN(auto name, a.require("slave"));
+    auto s = slaveIndex(name);
+    if (!s.ok()) return a.error(s.error().context);
+    ECSIM_ASSIGN_OR_RETURN(auto channel, a.number("channel"));
+    ECSIM_ASSIGN_OR_RETURN(auto text, a.require("signal"));
+    auto signal = slavesim::devices::parseSignal(text);
+    if (!signal.ok()) return a.error(signal.error().context);
+    auto& slave = segment_.slave(*s);
+    if (auto* di = slavesim::devices::digitalInputsOf(slave)) {
+      di->setScript(static_cast<unsigned>(channel), *signal);
+    } else if (auto* ai = slavesim::devices::analogInputsOf(slave)) {
+      ai->setScript(static_cast<unsigned>(channel), *signal);
+    } else {
+      return a.error(slave.name() + " has no scriptable inputs");
+    }
+    return fmt::format("{} input {} = {}", slave.name(), channel, text);
+  }
+  // The remaining verbs address one slave.
+  ECSIM_ASSIGN_OR_RETURN(auto name, a.require("slave"));
+  auto index = slaveIndex(name);
+  if (!index.ok()) return a.error(index.error().context);
+  const std::size_t s = *index;
+  auto& slave = segment_.slave(s);
+  if (v == "power-off") return powerOff(s);
+  if (v == "power-on") return powerOn(s);
+  if (v == "power-cycle") {
+    if (auto off = powerOff(s); !off.ok()) return off.takeError();
+    return powerOn(s);
+  }
+  if (v == "al-error") {
+    ECSIM_ASSIGN_OR_RETURN(auto code, a.number("code"));
+    AlState target = std::min(slave.state(), AlState::kSafeOp);
+    if (auto st = a.get("state")) {
+      auto parsed = stateFromName(*st);
+      if (!parsed) return a.error("state must be INIT, PREOP, SAFEOP or OP");
+      target = *parsed;
+    }
+    slave.stateMachine().raiseError(slave.esc(), target, static_cast<std::uint16_t>(code));
+    return fmt::format("{}: AL error {:#06x} ({}), now {}+ERR", slave.name(), code,
+                       alStatusCodeText(static_cast<std::uint16_t>(code)), toString(target));
+  }
+  if (v == "eeprom-checksum") {
+    auto& esc = slave.esc();
+    if (esc.sii().size() <= kSiiChecksumByte) return a.error("the slave has no EEPROM");
+    esc.writeSiiByte(kSiiChecksumByte,
+                     static_cast<std::uint8_t>(esc.sii()[kSiiChecksumByte] ^ 0x5A));
+    if (auto off = powerOff(s); !off.ok()) return off.takeError();
+    return powerOn(s);
+  }
+  if (v == "mailbox-silent" || v == "mailbox-ok") {
+    if (slave.mailboxServer() == nullptr) return a.error(slave.name() + " has no mailbox");
+    ECSIM_ASSIGN_OR_RETURN(auto on, a.number("on", v == "mailbox-silent" ? 1 : 0));
+    faultyMailbox(slave).silent = on != 0;
+    return fmt::format("{}: mailbox {}", slave.name(), on != 0 ? "silent" : "answering");
+  }
+  if (v == "sdo-abort" || v == "sdo-ok") {
+    if (slave.mailboxServer() == nullptr) return a.error(slave.name() + " has no mailbox");
+    auto& mbx = faultyMailbox(slave);
+    if (v == "sdo-ok") {
+      mbx.aborts.clear();
+      return slave.name() + ": SDO aborts removed";
+    }
+    ECSIM_ASSIGN_OR_RETURN(auto objIndex, a.number("index"));
+    ECSIM_ASSIGN_OR_RETURN(auto code, a.number("code", 0x06020000));  // object does not exist
+    FaultyMailbox::Rule rule{static_cast<std::uint16_t>(objIndex), std::nullopt,
+                             static_cast<std::uint32_t>(code)};
+    if (a.get("sub")) {
+      ECSIM_ASSIGN_OR_RETURN(auto sub, a.number("sub"));
+      rule.subindex = static_cast<std::uint8_t>(sub);
+    }
+    mbx.aborts.push_back(rule);
+    return fmt::format("{}: SDO {:#06x} aborted with {:#010x} ({})", slave.name(), objIndex, code,
+                       sdoAbortText(static_cast<std::uint32_t>(code)));
+  }
+  if (v == "drive-fault" || v == "encoder-fault") {
+    auto* drive = slavesim::devices::driveOf(slave);
+    if (drive == nullptr) return a.error(slave.name() + " is not a CiA 402 drive");
+    std::uint16_t code = kPositionSensorFault;
+    if (v == "drive-fault") {
+      ECSIM_ASSIGN_OR_RETURN(auto c, a.number("code", kOvercurrent));
+      code = static_cast<std::uint16_t>(c);
+    }
+    drive->injectFault(code);
+    return fmt::format("{}: drive fault {:#06x}", slave.name(), code);
+  }
+  return a.error("unknown action");
+}
+
+}  // namespace ecsim::topology

@@ -1,0 +1,130 @@
+// Fault injection on a simulated network: the network-side actions of scenarios
+// (docs/scenarios.md) and of `ecsim ctl`. An action is a verb with key=value arguments, the same
+// in a scenario file (<Action do="link-down" cable="drives"/>) and on a control line
+// ("link-down cable=drives"). FaultInjector applies them to a Network:
+//
+//   loss rate=R [cable=C]           frames lost (bad FCS) with probability R where cable C
+//                                   (default: the master's) enters its downstream slave
+//   corrupt cable=C [count=N]       the next N frames (default 1) arrive corrupted there
+//   delay cable=C ns=N durationMs=T the cable takes N ns longer, each way, for T ms
+//   link-down|link-up cable=C | slave=S port=P
+//   power-off|power-on slave=S      off: a broken link at the neighbours' ports; on: power-on
+//                                   reset (registers, AL state; EEPROM and encoder state kept)
+//   al-error slave=S code=X [state=SAFEOP]   the firmware raises a local error
+//   eeprom-checksum slave=S         corrupts the SII checksum (word 7) and power-cycles
+//   mailbox-silent slave=S [on=0|1] the mailbox server stops (or resumes) answering
+//   sdo-abort slave=S index=X [sub=N] code=X  SDO requests for that object are aborted
+//   sdo-ok slave=S                  removes the SDO aborts
+//   drive-fault slave=S [code=X]    CiA 402 drive fault (default 0x2310 overcurrent)
+//   encoder-fault slave=S           drive fault 0x7305 (position sensor)
+//   input slave=S channel=N signal=TEXT    scripted input (slavesim/devices/signal.hpp)
+//
+// Random decisions come from a SplitMix64 generator seeded by the caller: the same seed and the
+// same frames give the same faults.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "protocol/result.hpp"
+#include "protocol/time.hpp"
+#include "topology/network_builder.hpp"
+#include "topology/segment.hpp"
+
+namespace ecsim::topology {
+
+// Steele, Lea, Flood: "Fast splittable pseudorandom number generators" (SplitMix64).
+class SplitMix64 {
+ public:
+  explicit SplitMix64(std::uint64_t seed) : state_(seed) {}
+  std::uint64_t next() {
+    std::uint64_t z = (state_ += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+  }
+  // Uniform in [0, 1) from the top 53 bits.
+  double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
+
+ private:
+  std::uint64_t state_;
+};
+
+struct FaultAction {
+  std::string verb;
+  std::map<std::string, std::string, std::less<>> args;
+  std::string where;  // "file.xml, line 12" or "control": prefixes error messages
+
+  std::optional<std::string_view> get(std::string_view key) const;
+  Result<std::string_view> require(std::string_view key) const;
+  Result<std::uint64_t> number(std::string_view key) const;  // decimal or 0x hex
+  Result<std::uint64_t> number(std::string_view key, std::uint64_t fallback) const;
+  Result<double> real(std::string_view key) const;
+  Error error(std::string_view message) const;
+  // "link-down cable=drives" (arguments in key order).
+  std::string text() const;
+};
+
+// "verb key=value key="quoted value" ..." (a control line).
+Result<FaultAction> parseFaultAction(std::string_view line);
+// Decimal or 0x-prefixed hexadecimal.
+std::optional<std::uint64_t> parseNumber(std::string_view text);
+
+class FaultInjector final : public WireFaults {
+ public:
+  // Installs itself as the segment's wire faults; removes itself when destroyed.
+  FaultInjector(Network& network, std::uint64_t seed);
+  ~FaultInjector() override;
+  FaultInjector(const FaultInjector&) = delete;
+  FaultInjector& operator=(const FaultInjector&) = delete;
+
+  static bool handles(std::string_view verb);
+  // Applies a network-side action at simulation time `now`; returns what was done in words.
+  Result<std::string> apply(const FaultAction& action, SimTime now);
+
+  bool corrupts(std::size_t slave, unsigned port, SimTime time) override;
+  SimTime extraDelay(std::size_t slave, unsigned port, SimTime time) override;
+
+  Result<std::size_t> slaveIndex(std::string_view name) const;
+  std::uint64_t framesCorrupted() const { return framesCorrupted_; }
+
+ private:
+  struct End {
+    std::size_t slave{0};
+    unsigned port{0};
+    auto operator<=>(const End&) const = default;
+  };
+  struct Spike {
+    End end;
+    SimTime extra{0};
+    SimTime until{0};
+  };
+  Result<End> cableEnd(const FaultAction& action) const;
+  // The other end of the cable at `end`, if there is one (the master cable has none).
+  std::optional<End> peer(End end) const;
+  void setCable(End end, bool up);
+  Result<std::string> powerOff(std::size_t s);
+  Result<std::string> powerOn(std::size_t s);
+
+  Network& network_;
+  Segment& segment_;
+  SplitMix64 random_;
+  std::map<End, double> lossRate_;
+  std::map<End, std::uint64_t> corruptCount_;
+  std::vector<Spike> spikes_;
+  std::set<End> cablesDown_;  // by link-down, kept down through power cycles
+  std::set<std::size_t> poweredOff_;
+  std::uint64_t framesCorrupted_{0};
+  bool anyWireFault_{false};
+  void refreshAny() {
+    anyWireFault_ = !lossRate_.empty() || !corruptCount_.empty() || !spikes_.empty();
+  }
+};
+
+}  // namespace ecsim::topology
