@@ -158,6 +158,7 @@ Status Master::readStates() {
 }
 
 Status Master::requestState(AlState target) {
+  ECSIM_TRY(runInitCommands(target, InitPhase::kBefore));
   StateChangeTask task(transport_, slaves_, options_.state);
   task.start(target, bus_.now());
   const SimTime timeout = options_.state.timeout + kNsPerSecond;
@@ -173,10 +174,12 @@ Status Master::requestState(AlState target) {
   }
   refusals_ = task.refusals();
   ECSIM_TRY(ran);
-  return task.status();
+  ECSIM_TRY(task.status());
+  return runInitCommands(target, InitPhase::kAfter);
 }
 
 Status Master::configureProcessData() {
+  ECSIM_TRY(runInitCommands(AlState::kSafeOp, InitPhase::kBefore));  // PDO assignment first
   processData_.assign(slaves_.size(), {});
   std::vector<std::unique_ptr<PdoDiscoveryTask>> discoveries(slaves_.size());
   TaskGroup group;
@@ -250,6 +253,7 @@ Status Master::start() {
   ECSIM_TRY(scan());
   if (config_) ECSIM_TRY(checkIdentities(*config_, slaves_));
   if (slaves_.empty()) return makeError(ErrorCode::kNotFound, "no slaves found");
+  ECSIM_TRY(applyEniSetup());
   return bringTo(AlState::kOp);
 }
 

@@ -28,7 +28,7 @@
 #include "master/bus.hpp"
 #include "master/coe_client.hpp"
 #include "master/cyclic.hpp"
-#include "master/master_config.hpp"
+#include "master/eni_config.hpp"
 #include "master/pdo_config.hpp"
 #include "master/process_image.hpp"
 #include "master/scan.hpp"
@@ -114,6 +114,12 @@ class Master {
   Result<SlaveInfo*> slaveAt(std::size_t position);
   Status sendCycle();
   CycleResult finishCycle();
+  // ENI configuration (master/eni_master.cpp): station addresses and mailbox areas after the
+  // scan; init commands of each slave's transition to `target`: register and CoE commands
+  // before the request (phase kBefore), CoE commands of IP once PREOP is reached (kAfter).
+  enum class InitPhase { kBefore, kAfter };
+  Status applyEniSetup();
+  Status runInitCommands(AlState target, InitPhase phase);
 
   MasterOptions options_;
   Transport transport_;
@@ -127,6 +133,8 @@ class Master {
   CycleResult lastCycle_;
   std::vector<StateRefusal> refusals_;
   std::vector<ReceivedEmergency> emergencies_;
+  std::optional<AlState> initCmdsDoneFor_;  // the before-phase already ran for this target
+  std::vector<char> transitionFrom_;        // per slave: the state letter it left
 };
 
 }  // namespace ecsim::master

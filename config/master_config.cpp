@@ -1,5 +1,5 @@
-// Reads the master configuration with tinyxml2 (the library config/ uses for its readers).
-#include "master/master_config.hpp"
+// Reads the master configuration with tinyxml2; ENI files through config/eni.hpp.
+#include "config/master_config.hpp"
 
 #include <tinyxml2.h>
 
@@ -7,9 +7,10 @@
 #include <fstream>
 #include <sstream>
 
+#include "config/eni.hpp"
 #include "config/esi.hpp"
 
-namespace ecsim::master {
+namespace ecsim {
 namespace {
 
 Error parseError(std::string_view file, int line, const std::string& what) {
@@ -27,12 +28,6 @@ Result<std::optional<std::uint32_t>> attribute(const tinyxml2::XMLElement* e, co
                       std::string("attribute ") + name + ": '" + raw + "' is not a 32-bit number");
   }
   return std::optional<std::uint32_t>{static_cast<std::uint32_t>(*value)};
-}
-
-std::string hex8(std::uint32_t v) {
-  char buf[16];
-  std::snprintf(buf, sizeof buf, "0x%08X", v);
-  return buf;
 }
 
 }  // namespace
@@ -71,41 +66,39 @@ Result<MasterConfig> parseMasterConfig(std::string_view xml, std::string_view fi
   return config;
 }
 
+MasterConfig masterConfigFromEni(EniConfig eni) {
+  MasterConfig config;
+  config.file = eni.file.string();
+  for (const EniSlave& s : eni.slaves) {
+    ExpectedSlave slave;
+    slave.name = s.name;
+    slave.vendorId = s.vendorId;
+    slave.productCode = s.productCode;
+    slave.revision = s.revisionNo;
+    // ENI tools write SerialNo 0 when they do not check it.
+    if (s.serialNo && *s.serialNo != 0) slave.serial = s.serialNo;
+    slave.station = s.physAddr;
+    slave.line = s.line;
+    config.slaves.push_back(std::move(slave));
+  }
+  config.eni = std::move(eni);
+  return config;
+}
+
 Result<MasterConfig> loadMasterConfig(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return makeError(ErrorCode::kIo, path.string() + ": cannot be read");
   std::ostringstream text;
   text << in.rdbuf();
-  return parseMasterConfig(text.str(), path.string());
+  const std::string xml = text.str();
+  tinyxml2::XMLDocument doc;
+  const bool parsed = doc.Parse(xml.data(), xml.size()) == tinyxml2::XML_SUCCESS;
+  if (parsed && doc.RootElement() != nullptr &&
+      std::string_view(doc.RootElement()->Name()) == "EtherCATConfig") {
+    ECSIM_ASSIGN_OR_RETURN(EniConfig eni, parseEni(xml, path));
+    return masterConfigFromEni(std::move(eni));
+  }
+  return parseMasterConfig(xml, path.string());
 }
 
-Status checkIdentities(const MasterConfig& config, const std::vector<SlaveInfo>& slaves) {
-  if (config.slaves.size() != slaves.size()) {
-    return makeError(ErrorCode::kNotFound,
-                     config.file + " expects " + std::to_string(config.slaves.size()) +
-                         " slaves, the bus has " + std::to_string(slaves.size()));
-  }
-  std::string context;
-  for (std::size_t i = 0; i < slaves.size(); ++i) {
-    const ExpectedSlave& want = config.slaves[i];
-    const SiiIdentity& have = slaves[i].identity();
-    std::string diff;
-    auto compare = [&](std::string_view what, std::uint32_t expected, std::uint32_t found) {
-      if (expected == found) return;
-      diff += (diff.empty() ? "" : ", ") + std::string(what) + " " + hex8(found) + " (expected " +
-              hex8(expected) + ")";
-    };
-    compare("vendor", want.vendorId, have.vendorId);
-    compare("product code", want.productCode, have.productCode);
-    if (want.revision) compare("revision", *want.revision, have.revision);
-    if (want.serial) compare("serial", *want.serial, have.serial);
-    if (diff.empty()) continue;
-    std::string expected = want.name.empty() ? "" : " configured as '" + want.name + "'";
-    context += (context.empty() ? "" : "; ") + slaves[i].label() + expected + ", " + config.file +
-               " line " + std::to_string(want.line) + ": " + diff;
-  }
-  if (context.empty()) return okStatus();
-  return makeError(ErrorCode::kInvalidArgument, "identity mismatch: " + context);
-}
-
-}  // namespace ecsim::master
+}  // namespace ecsim
