@@ -200,6 +200,10 @@ struct EniConfig {
 Result<EniConfig> parseEni(std::string_view xml, const std::filesystem::path& file);
 Result<EniConfig> loadEniFile(const std::filesystem::path& path);
 
+// Writes `eni` as ENI XML that parseEni reads back to the same structs (config/eni_format.cpp):
+// numbers in decimal, identity and addresses as #x hex, Data as hex bytes.
+std::string formatEni(const EniConfig& eni);
+
 // The name of the root element of an XML file ("EtherCATConfig", "Topology", ...), for tools
 // that accept several kinds of file.
 Result<std::string> xmlRootName(const std::filesystem::path& path);

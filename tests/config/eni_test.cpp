@@ -191,6 +191,39 @@ TEST(EniTest, MasterConfigReadsEniOrTheSimpleFormat) {
   EXPECT_FALSE(simple->slaves.at(0).station);
 }
 
+TEST(EniTest, FormatEniReadsBackToTheSameConfiguration) {
+  auto eni = loadEniFile(kDemoEni);
+  ASSERT_TRUE(eni.ok()) << eni.error().message();
+  const std::string written = formatEni(*eni);
+  auto again = parseEni(written, "written.xml");
+  ASSERT_TRUE(again.ok()) << again.error().message() << "\n" << written;
+  // Writing what was read back gives the same text: nothing was lost on the way.
+  EXPECT_EQ(formatEni(*again), written);
+  ASSERT_EQ(again->slaves.size(), eni->slaves.size());
+  for (std::size_t i = 0; i < eni->slaves.size(); ++i) {
+    const EniSlave& a = eni->slaves[i];
+    const EniSlave& b = again->slaves[i];
+    EXPECT_EQ(a.name, b.name);
+    EXPECT_EQ(a.physAddr, b.physAddr);
+    EXPECT_EQ(a.productCode, b.productCode);
+    EXPECT_EQ(a.initCmds.size(), b.initCmds.size());
+    EXPECT_EQ(a.initCmds[0].data, b.initCmds[0].data);
+    EXPECT_EQ(a.mailbox.has_value(), b.mailbox.has_value());
+    EXPECT_EQ(a.processData.txPdos.size(), b.processData.txPdos.size());
+    EXPECT_EQ(a.previousPorts.size(), b.previousPorts.size());
+    EXPECT_EQ(a.dcCapable, b.dcCapable);
+  }
+  EXPECT_EQ(again->slaves[4].mailbox->coeInitCmds.at(0).index, 0x6060);
+  EXPECT_EQ(again->cyclic.at(0).frames.at(0).cmds.at(0).state, "SAFEOP OP");
+  EXPECT_EQ(again->processImage.inputs.size(), eni->processImage.inputs.size());
+  // Text that needs escaping survives.
+  EniConfig odd;
+  odd.master.name = "A & B <master>";
+  auto oddAgain = parseEni(formatEni(odd), "odd.xml");
+  ASSERT_TRUE(oddAgain.ok()) << oddAgain.error().message();
+  EXPECT_EQ(oddAgain->master.name, "A & B <master>");
+}
+
 TEST(EniTest, RootNameTellsTheKindOfFile) {
   auto root = xmlRootName(kDemoEni);
   ASSERT_TRUE(root.ok());
