@@ -1,0 +1,78 @@
+# Installation and the CMake/pkg-config packages (issue #10). Included at the end of the
+# top-level CMakeLists.txt, after every library exists.
+#
+#   <prefix>/include/ecsim/{protocol,link,config,slavesim,topology,master,embed}/*.hpp
+#   <prefix>/lib/libecsim_*.a
+#   <prefix>/lib/cmake/ecsim/ecsimConfig.cmake (+ version, exported targets)
+#   <prefix>/lib/pkgconfig/ecsim.pc
+#   <prefix>/bin/ecsim, ecmaster and <prefix>/share/ecsim/{esi,topologies} (installed by
+#   tools/ecsim and tools/ecmaster), <prefix>/share/ecsim/examples/user-project
+#
+# Headers keep the source layout under include/ecsim, and include/ecsim is an include
+# directory of every exported target, so installed code includes "protocol/result.hpp"
+# exactly as the sources do (<ecsim/protocol/result.hpp> works too).
+include(GNUInstallDirs)
+include(CMakePackageConfigHelpers)
+
+set(ecsim_install_libraries protocol link config slavesim topology master embed)
+set(ecsim_install_cmakedir ${CMAKE_INSTALL_LIBDIR}/cmake/ecsim)
+
+foreach(lib ${ecsim_install_libraries})
+  set_target_properties(ecsim_${lib} PROPERTIES EXPORT_NAME ${lib})
+  target_include_directories(ecsim_${lib} PUBLIC
+    $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/ecsim>)
+  install(DIRECTORY ${PROJECT_SOURCE_DIR}/${lib}/
+          DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/ecsim/${lib}
+          FILES_MATCHING PATTERN "*.hpp")
+endforeach()
+
+# The static libraries link ecsim_options privately; their exported link interface names it
+# ($<LINK_ONLY:...>), so it is exported too. Only its link options reach a user's program: the
+# sanitizer runtime when ECSIM_SANITIZE built the libraries, nothing otherwise.
+set_target_properties(ecsim_options PROPERTIES EXPORT_NAME options)
+
+# ecsim::sim: the simulator (protocol, link, config, slavesim, topology, embed).
+add_library(ecsim_sim INTERFACE)
+add_library(ecsim::sim ALIAS ecsim_sim)
+set_target_properties(ecsim_sim PROPERTIES EXPORT_NAME sim)
+target_link_libraries(ecsim_sim INTERFACE ecsim_embed ecsim_topology ecsim_slavesim ecsim_config
+                                          ecsim_link ecsim_protocol)
+
+# ecsim::testing: the GoogleTest fixture (embed/testing/network_fixture.hpp, header-only) with
+# what it needs from ecsim. The user links GTest::gtest (or gtest_main) as usual.
+add_library(ecsim_testing INTERFACE)
+add_library(ecsim::testing ALIAS ecsim_testing)
+set_target_properties(ecsim_testing PROPERTIES EXPORT_NAME testing)
+target_link_libraries(ecsim_testing INTERFACE ecsim_sim ecsim_master)
+
+set(ecsim_install_targets ecsim_options ecsim_sim ecsim_testing)
+foreach(lib ${ecsim_install_libraries})
+  list(APPEND ecsim_install_targets ecsim_${lib})
+endforeach()
+install(TARGETS ${ecsim_install_targets} EXPORT ecsimTargets
+        ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/ecsim)
+install(EXPORT ecsimTargets NAMESPACE ecsim:: DESTINATION ${ecsim_install_cmakedir})
+
+configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/ecsimConfig.cmake.in
+  ${PROJECT_BINARY_DIR}/ecsimConfig.cmake INSTALL_DESTINATION ${ecsim_install_cmakedir})
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/ecsimConfigVersion.cmake
+  VERSION ${PROJECT_VERSION} COMPATIBILITY SameMinorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/ecsimConfig.cmake ${PROJECT_BINARY_DIR}/ecsimConfigVersion.cmake
+        DESTINATION ${ecsim_install_cmakedir})
+
+# pkg-config: the same libraries in link order; dependencies through their own .pc files.
+set(ecsim_pc_sanitize "")
+if(ECSIM_SANITIZE)
+  set(ecsim_pc_sanitize "-fsanitize=address,undefined")
+endif()
+# Relocatable: the prefix is found from the .pc file's own folder (pkg-config's pcfiledir).
+file(RELATIVE_PATH ecsim_pc_up /${CMAKE_INSTALL_LIBDIR}/pkgconfig /)
+string(REGEX REPLACE "/$" "" ecsim_pc_up "${ecsim_pc_up}")
+configure_file(${PROJECT_SOURCE_DIR}/cmake/ecsim.pc.in ${PROJECT_BINARY_DIR}/ecsim.pc @ONLY)
+install(FILES ${PROJECT_BINARY_DIR}/ecsim.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+
+# A starting point for users: the stand-alone project our package test builds.
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/examples/user-project
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/ecsim/examples)
