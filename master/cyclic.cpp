@@ -27,7 +27,10 @@ Status CyclicExchange::build(const ProcessImageLayout& layout, const MacAddress&
   datagrams_.clear();
   outputs_.clear();
   inputs_.clear();
+  expectedMin_.clear();
+  expectedMax_.clear();
   statistics_ = {};
+  lastSend_.reset();
   EthernetHeader ethernet;
   ethernet.destination = kBroadcastMac;
   ethernet.source = source;
@@ -63,7 +66,25 @@ Status CyclicExchange::build(const ProcessImageLayout& layout, const MacAddress&
     add(inputs_, layout.outputBytes, layout.size());
   }
   layout_ = &layout;
+  resetExpectedWkcs();
   return okStatus();
+}
+
+void CyclicExchange::resetExpectedWkcs() {
+  expectedMin_.clear();
+  expectedMax_.clear();
+  if (layout_ == nullptr) return;
+  for (const auto& d : layout_->datagrams) {
+    expectedMin_.push_back(d.expectedWkc);
+    expectedMax_.push_back(d.expectedWkc);
+  }
+}
+
+std::optional<std::uint16_t> CyclicExchange::receivedWkc(std::size_t datagram) const {
+  if (datagram >= datagrams_.size()) return std::nullopt;
+  const CachedFrame& frame = *frames_[datagrams_[datagram].frame];
+  if (frame.state() != DatagramState::kReceived) return std::nullopt;
+  return frame.rxWkc(datagrams_[datagram].index);
 }
 
 Status CyclicExchange::send(Transport& transport, ConstBytes image, SimTime now) {
@@ -79,6 +100,11 @@ Status CyclicExchange::send(Transport& transport, ConstBytes image, SimTime now)
                 c.length);
   }
   ++statistics_.cycles;
+  if (period_ > 0 && lastSend_) {
+    const SimTime deviation = (now - *lastSend_) - period_;
+    statistics_.jitter.record(deviation < 0 ? -deviation : deviation);
+  }
+  lastSend_ = now;
   for (auto& frame : frames_) {
     ECSIM_TRY(transport.send(*frame, now));
     ++statistics_.framesSent;
@@ -107,6 +133,8 @@ CycleResult CyclicExchange::finish(Bytes image) {
       statistics_.roundTripMax = std::max(statistics_.roundTripMax, rtt);
       statistics_.roundTripSum += rtt;
       ++statistics_.roundTrips;
+      statistics_.roundTrip.record(rtt);
+      if (deadline_ > 0 && rtt > deadline_) ++result.framesLate;
     } else {
       ++result.framesLost;
     }
@@ -121,15 +149,17 @@ CycleResult CyclicExchange::finish(Bytes image) {
     if (frame.state() != DatagramState::kReceived) continue;
     const std::uint16_t wkc = frame.rxWkc(datagrams_[i].index);
     const LogicalDatagram& d = layout_->datagrams[i];
-    if (wkc == d.expectedWkc) continue;
+    if (wkc >= expectedMin_[i] && wkc <= expectedMax_[i]) continue;
     ++result.wkcErrors;
     if (!result.firstMismatch) {
-      result.firstMismatch = WkcMismatch{
-          i, d.logicalStart, d.length, d.expectedWkc, wkc, std::span<const std::size_t>(d.slaves)};
+      result.firstMismatch = WkcMismatch{i,        d.logicalStart,
+                                         d.length, expectedMin_[i],
+                                         wkc,      std::span<const std::size_t>(d.slaves)};
     }
   }
   statistics_.framesLost += result.framesLost;
   statistics_.wkcErrors += result.wkcErrors;
+  statistics_.framesLate += result.framesLate;
   if (!result.ok()) ++statistics_.cyclesWithErrors;
   return result;
 }

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "master/histogram.hpp"
 #include "master/process_image.hpp"
 #include "master/transport.hpp"
 
@@ -39,6 +40,7 @@ struct CycleResult {
   std::size_t framesAnswered{0};
   std::size_t framesLost{0};  // unanswered when the cycle was finished
   std::size_t wkcErrors{0};   // datagrams answered with a WKC other than expected
+  std::size_t framesLate{0};  // answered, but later than the deadline (setTiming)
   std::optional<WkcMismatch> firstMismatch;
   SimTime maxRoundTrip{0};
   bool ok() const { return framesLost == 0 && wkcErrors == 0; }
@@ -57,6 +59,11 @@ struct CyclicStatistics {
   SimTime roundTripMean() const {
     return roundTrips == 0 ? 0 : roundTripSum / static_cast<SimTime>(roundTrips);
   }
+  std::uint64_t framesLate{0};  // answered after the deadline (setTiming)
+  // Every answered frame's round trip, and each cycle's start-to-start deviation from the
+  // nominal period (setTiming): fixed buckets, filled without allocating.
+  LatencyHistogram roundTrip;
+  LatencyHistogram jitter;
 };
 
 class CyclicExchange {
@@ -79,7 +86,29 @@ class CyclicExchange {
   CycleResult finish(Bytes image);
 
   const CyclicStatistics& statistics() const { return statistics_; }
-  void resetStatistics() { statistics_ = {}; }
+  void resetStatistics() {
+    statistics_ = {};
+    lastSend_.reset();
+  }
+  // The nominal cycle period (for jitter; 0: no jitter recorded) and the deadline after which
+  // an answered frame counts as late (0: none).
+  void setTiming(SimTime period, SimTime deadline) {
+    period_ = period;
+    deadline_ = deadline;
+    lastSend_.reset();
+  }
+
+  // The WKCs a datagram is accepted with: the layout's expected value, unless widened or
+  // lowered (recovery does, while slaves are missing or being reconfigured);
+  // resetExpectedWkcs() restores the layout's values.
+  std::uint16_t expectedWkc(std::size_t datagram) const { return expectedMin_[datagram]; }
+  void setExpectedWkc(std::size_t datagram, std::uint16_t min, std::uint16_t max) {
+    expectedMin_[datagram] = min;
+    expectedMax_[datagram] = max;
+  }
+  void resetExpectedWkcs();
+  // The WKC datagram `datagram` came back with in the last finished cycle (nullopt: lost).
+  std::optional<std::uint16_t> receivedWkc(std::size_t datagram) const;
 
  private:
   struct Copy {
@@ -98,7 +127,12 @@ class CyclicExchange {
   std::vector<DatagramRef> datagrams_;  // parallel to layout_->datagrams
   std::vector<Copy> outputs_;
   std::vector<Copy> inputs_;
+  std::vector<std::uint16_t> expectedMin_;  // parallel to layout_->datagrams
+  std::vector<std::uint16_t> expectedMax_;
   CyclicStatistics statistics_{};
+  SimTime period_{0};
+  SimTime deadline_{0};
+  std::optional<SimTime> lastSend_;
 };
 
 }  // namespace ecsim::master

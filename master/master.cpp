@@ -120,6 +120,8 @@ Status Master::scan() {
   processData_.clear();
   layout_ = {};
   image_.clear();
+  health_.reset();
+  variables_.clear();
   (void)cyclic_.build(layout_, options_.transport.source);
   ScanTask task(transport_, slaves_, options_.scan);
   task.start(bus_.now());
@@ -219,7 +221,16 @@ Status Master::configureProcessData() {
     return makeError(s.error().code, "SM/FMMU setup: " + s.error().context);
   }
   image_.assign(layout_.size(), 0);
-  return cyclic_.build(layout_, options_.transport.source);
+  ECSIM_TRY(cyclic_.build(layout_, options_.transport.source));
+  cyclic_.setTiming(options_.cycleTime, options_.cycleTime);
+  health_ = std::make_unique<HealthMonitor>(transport_, slaves_, layout_, cyclic_,
+                                            options_.recovery, options_.health, options_.state);
+  std::vector<std::string> names;  // the configuration's names, else the SII's
+  if (config_) {
+    for (const auto& expected : config_->slaves) names.push_back(expected.name);
+  }
+  variables_ = nameVariables(layout_, slaves_, names);
+  return okStatus();
 }
 
 Status Master::bringTo(AlState target) {
@@ -382,6 +393,41 @@ Status Master::writeRegisters(std::size_t position, std::uint16_t address, Const
   BatchWait wait(batch);
   ECSIM_TRY(run(wait, options_.state.timeout, "register write"));
   return batch.check();
+}
+
+Status Master::cycle() {
+  Status status = exchange();
+  if (health_) health_->afterCycle(lastCycle_, cyclic_.statistics().cycles, bus_.now());
+  return status;
+}
+
+const std::vector<MasterEvent>& Master::events() const {
+  return health_ ? health_->events() : noEvents_;
+}
+
+void Master::clearEvents() {
+  if (health_) health_->clearEvents();
+}
+
+MasterHealth Master::health() const {
+  return health_ ? health_->health(transport_.counters()) : MasterHealth{};
+}
+
+void Master::setCycleTime(SimTime period) {
+  options_.cycleTime = period;
+  cyclic_.setTiming(period, period);
+}
+
+void Master::resetStatistics() {
+  cyclic_.resetStatistics();
+}
+
+Result<PdoVariable> Master::variable(std::string_view name) {
+  if (variables_.empty()) {
+    return makeError(ErrorCode::kState, "no process data configured (start() first)");
+  }
+  ECSIM_ASSIGN_OR_RETURN(VariableInfo info, findVariable(variables_, name));
+  return PdoVariable(std::move(info), image_);
 }
 
 }  // namespace ecsim::master

@@ -29,12 +29,14 @@
 #include "master/coe_client.hpp"
 #include "master/cyclic.hpp"
 #include "master/eni_config.hpp"
+#include "master/health.hpp"
 #include "master/pdo_config.hpp"
 #include "master/process_image.hpp"
 #include "master/scan.hpp"
 #include "master/slave_info.hpp"
 #include "master/state_change.hpp"
 #include "master/transport.hpp"
+#include "master/variables.hpp"
 
 namespace ecsim::master {
 
@@ -49,6 +51,11 @@ struct MasterOptions {
   SimTime cycleTime{kNsPerMs};
   SimTime scanTimeout{30 * kNsPerSecond};
   SimTime mailboxTimeout{10 * kNsPerSecond};  // one SDO transfer or PDO discovery
+  // Cyclic health (master/health.hpp) in cycle(): with recovery a slave that disappears is
+  // reported, the others keep running, and it is brought back to OP when it returns; without,
+  // nothing is read or reconfigured and every missing working counter is a WKC error.
+  bool recovery{true};
+  HealthOptions health;
 };
 
 class Master {
@@ -70,6 +77,30 @@ class Master {
   // check WKCs. kWorkingCounter naming the slaves concerned, kTimeout for a lost frame.
   Status exchange();
   Status stop();
+
+  // ---- cyclic health, recovery, names (master/health.hpp, recovery.hpp, variables.hpp) ------
+  // One cycle with health and recovery: exchange(), then the HealthMonitor looks at the
+  // result, queues its AL status reads (every HealthOptions::statusInterval cycles, and at once
+  // after an error) and steps any slave's recovery by one step; those datagrams travel beside
+  // the next cycles' frames. Returns exchange()'s status (after a slave is reported lost its
+  // working counters are no longer expected, so the cycles are ok again).
+  //
+  //   while (running) { master.cycle(); for (auto& e : master.events()) log(e.text); ... }
+  Status cycle();
+  // Lost / returned / reset / error / recovered / recovery failed, oldest first, each naming
+  // the slave and the cycle ("slave 3 (0x1004 'DO1') lost at cycle 1002").
+  const std::vector<MasterEvent>& events() const;
+  void clearEvents();
+  // Per slave: condition, AL status as last read, lost/recovered counts; cyclic counters.
+  MasterHealth health() const;
+  // The period jitter is measured against and after which an answer counts as late (default
+  // MasterOptions::cycleTime); resetStatistics() empties counters and histograms.
+  void setCycleTime(SimTime period);
+  void resetStatistics();
+  // A process-data variable by name ("Drive1.Statusword", "DI1.Input 3", or the aliases
+  // master/variables.hpp lists), bound to the process image: get<std::int32_t>(), set(...).
+  Result<PdoVariable> variable(std::string_view name);
+  const std::vector<VariableInfo>& variables() const { return variables_; }
 
   // ---- steps and services (tools, tests) ----------------------------------------------------
   Status scan();
@@ -133,6 +164,9 @@ class Master {
   CycleResult lastCycle_;
   std::vector<StateRefusal> refusals_;
   std::vector<ReceivedEmergency> emergencies_;
+  std::unique_ptr<HealthMonitor> health_;  // made with the process image
+  std::vector<VariableInfo> variables_;
+  std::vector<MasterEvent> noEvents_;
   std::optional<AlState> initCmdsDoneFor_;  // the before-phase already ran for this target
   std::vector<char> transitionFrom_;        // per slave: the state letter it left
 };

@@ -1,0 +1,316 @@
+#include "master/health.hpp"
+
+#include <algorithm>
+
+namespace ecsim::master {
+namespace {
+
+constexpr std::uint16_t kAlStatusLength =
+    static_cast<std::uint16_t>(reg::kAlStatusCode.end() - reg::kAlStatus.address);
+
+bool overlaps(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) {
+  return a0 < b1 && b0 < a1;
+}
+
+// The working counter one slave adds to a datagram (the rule of planProcessImage()).
+std::uint16_t contribution(const ProcessImageLayout& layout, const LogicalDatagram& d,
+                           const SlaveLayout& sl) {
+  const std::uint32_t start = d.logicalStart - layout.logicalBase;
+  const std::uint32_t end = start + d.length;
+  const bool out =
+      sl.outputBytes > 0 && overlaps(start, end, sl.outputOffset, sl.outputOffset + sl.outputBytes);
+  const bool in =
+      sl.inputBytes > 0 && overlaps(start, end, sl.inputOffset, sl.inputOffset + sl.inputBytes);
+  return static_cast<std::uint16_t>((out ? 2 : 0) + (in ? 1 : 0));
+}
+
+// Where a recovery starts for a slave that answers at its station address.
+SlaveRecoveryTask::Stage firstStage(const SlaveInfo& slave) {
+  switch (slave.state().value_or(AlState::kInit)) {
+    case AlState::kInit:
+    case AlState::kBootstrap:
+      return SlaveRecoveryTask::Stage::kIdentity;
+    case AlState::kPreOp:
+      return SlaveRecoveryTask::Stage::kProcess;
+    case AlState::kSafeOp:
+    case AlState::kOp:
+      break;
+  }
+  return SlaveRecoveryTask::Stage::kOp;
+}
+
+}  // namespace
+
+std::string_view toString(SlaveCondition condition) {
+  switch (condition) {
+    case SlaveCondition::kOperational:
+      return "operational";
+    case SlaveCondition::kLost:
+      return "lost";
+    case SlaveCondition::kRecovering:
+      return "recovering";
+    case SlaveCondition::kFailed:
+      return "failed";
+  }
+  return "?";
+}
+
+std::string_view toString(MasterEventKind kind) {
+  switch (kind) {
+    case MasterEventKind::kSlaveLost:
+      return "lost";
+    case MasterEventKind::kSlaveReturned:
+      return "returned";
+    case MasterEventKind::kSlaveReset:
+      return "reset";
+    case MasterEventKind::kSlaveError:
+      return "error";
+    case MasterEventKind::kSlaveRecovered:
+      return "recovered";
+    case MasterEventKind::kRecoveryFailed:
+      return "recovery failed";
+  }
+  return "?";
+}
+
+bool MasterHealth::allOperational() const {
+  return std::all_of(slaves.begin(), slaves.end(), [](const SlaveHealth& s) {
+    return s.condition == SlaveCondition::kOperational;
+  });
+}
+
+HealthMonitor::HealthMonitor(Transport& transport, std::vector<SlaveInfo>& slaves,
+                             const ProcessImageLayout& layout, CyclicExchange& cyclic,
+                             bool recovery, HealthOptions options, StateChangeOptions state)
+    : transport_(transport),
+      slaveInfos_(slaves),
+      layout_(layout),
+      cyclic_(cyclic),
+      recovery_(recovery),
+      options_(options),
+      state_(state),
+      slaves_(slaves.size()) {
+  for (std::size_t i = 0; i < slaves.size(); ++i) {
+    SlaveHealth& h = slaves_[i].health;
+    h.position = slaves[i].position;
+    h.station = slaves[i].station;
+    h.name = slaves[i].name;
+    h.alStatus = slaves[i].alStatus;
+    h.alStatusCode = slaves[i].alStatusCode;
+  }
+  options_.statusInterval = std::max<std::uint64_t>(options_.statusInterval, 1);
+  options_.lostAfter = std::max(options_.lostAfter, 1u);
+}
+
+void HealthMonitor::event(MasterEventKind kind, std::size_t position, std::uint64_t cycle,
+                          SimTime now, const std::string& what) {
+  slaves_[position].health.lastEventCycle = cycle;
+  events_.push_back(
+      {kind, cycle, now, position,
+       slaveInfos_[position].label() + " " + what + " at cycle " + std::to_string(cycle)});
+}
+
+void HealthMonitor::afterCycle(const CycleResult& result, std::uint64_t cycle, SimTime now) {
+  if (!recovery_) return;
+  if (!result.ok()) suspicious_ = true;
+  if (readsOut_ && !reads_.pending()) {
+    readsOut_ = false;
+    takeStatusReads(cycle, now);
+  }
+  if (probesOut_ && !probes_.pending()) {
+    probesOut_ = false;
+    takeProbes(cycle, now);
+  }
+  bool changed = false;
+  for (std::size_t i = 0; i < slaves_.size(); ++i) {
+    Watch& w = slaves_[i];
+    if (!w.recovery || w.recovery->step(now)) continue;
+    if (w.recovery->status().ok()) {
+      w.health.condition = SlaveCondition::kOperational;
+      ++w.health.recoveredCount;
+      ++slavesRecovered_;
+      event(MasterEventKind::kSlaveRecovered, i, cycle, now, "back in OP");
+    } else {
+      w.health.condition = SlaveCondition::kFailed;
+      w.retryAt = cycle + options_.retryAfter;
+      event(MasterEventKind::kRecoveryFailed, i, cycle, now,
+            "not recovered (" + w.recovery->status().error().context + ")");
+    }
+    w.misses = 0;
+    w.recovery.reset();
+    changed = true;
+  }
+  if (changed) updateExpectations();
+  const bool anyMissing = std::any_of(slaves_.begin(), slaves_.end(), [](const Watch& w) {
+    return w.health.condition == SlaveCondition::kLost ||
+           w.health.condition == SlaveCondition::kFailed;
+  });
+  const std::uint64_t interval = anyMissing
+                                     ? std::max<std::uint64_t>(options_.statusInterval / 10, 1)
+                                     : options_.statusInterval;
+  if (!readsOut_ && !probesOut_ && (suspicious_ || cycle - lastRead_ >= interval)) {
+    suspicious_ = false;
+    lastRead_ = cycle;
+    queueStatusReads();
+  }
+}
+
+void HealthMonitor::queueStatusReads() {
+  reads_.clear();
+  readPositions_.clear();
+  probes_.clear();
+  probed_.clear();
+  for (std::size_t i = 0; i < slaves_.size(); ++i) {
+    const Watch& w = slaves_[i];
+    if (w.recovery) continue;
+    reads_.add().fprd(slaveInfos_[i].station, reg::kAlStatus.address, kAlStatusLength);
+    readPositions_.push_back(i);
+    if (w.health.condition == SlaveCondition::kLost ||
+        w.health.condition == SlaveCondition::kFailed) {
+      probes_.add().prepare(Command::kAprd,
+                            DatagramHeader::physical(Datagram::autoIncrement(i),
+                                                     reg::kConfiguredStationAddress.address),
+                            2, 1);
+      probed_.push_back(i);
+    }
+  }
+  if (!reads_.empty()) {
+    reads_.queueAll(transport_);
+    readsOut_ = true;
+  }
+  if (!probes_.empty()) {
+    probes_.queueAll(transport_);
+    probesOut_ = true;
+  }
+}
+
+void HealthMonitor::takeStatusReads(std::uint64_t cycle, SimTime now) {
+  bool changed = false;
+  for (std::size_t k = 0; k < readPositions_.size(); ++k) {
+    const std::size_t i = readPositions_[k];
+    Watch& w = slaves_[i];
+    SlaveInfo& info = slaveInfos_[i];
+    const Datagram& d = reads_[k];
+    if (w.recovery) continue;  // started meanwhile (by a probe)
+    if (d.wkcOk()) {
+      info.alStatus = readLe16(d.data(), 0);
+      info.alStatusCode = readLe16(d.data(), reg::kAlStatusCode.address - reg::kAlStatus.address);
+      w.health.alStatus = info.alStatus;
+      w.health.alStatusCode = info.alStatusCode;
+      w.misses = 0;
+      const bool inOp = info.state() == AlState::kOp && !info.alError();
+      switch (w.health.condition) {
+        case SlaveCondition::kOperational:
+          if (inOp) break;
+          ++w.health.errorCount;
+          event(MasterEventKind::kSlaveError, i, cycle, now,
+                "shows " + describeAlStatus(info.alStatus) + ", AL status code " +
+                    describeAlStatusCode(info.alStatusCode));
+          startRecovery(i, firstStage(info), now);
+          changed = true;
+          break;
+        case SlaveCondition::kFailed:
+          if (cycle < w.retryAt) break;
+          [[fallthrough]];
+        case SlaveCondition::kLost:
+          event(MasterEventKind::kSlaveReturned, i, cycle, now,
+                "answers again (" + describeAlStatus(info.alStatus) + ")");
+          if (inOp) {
+            w.health.condition = SlaveCondition::kOperational;
+            ++w.health.recoveredCount;
+            ++slavesRecovered_;
+            event(MasterEventKind::kSlaveRecovered, i, cycle, now, "back in OP");
+          } else {
+            startRecovery(i, firstStage(info), now);
+          }
+          changed = true;
+          break;
+        case SlaveCondition::kRecovering:
+          break;
+      }
+      continue;
+    }
+    if (w.health.condition != SlaveCondition::kOperational) continue;
+    if (++w.misses < options_.lostAfter) {
+      suspicious_ = true;  // read again at once
+      continue;
+    }
+    w.health.condition = SlaveCondition::kLost;
+    ++w.health.lostCount;
+    ++slavesLost_;
+    event(MasterEventKind::kSlaveLost, i, cycle, now, "lost");
+    changed = true;
+  }
+  if (changed) updateExpectations();
+}
+
+void HealthMonitor::takeProbes(std::uint64_t cycle, SimTime now) {
+  bool changed = false;
+  for (std::size_t k = 0; k < probed_.size(); ++k) {
+    const std::size_t i = probed_[k];
+    Watch& w = slaves_[i];
+    const Datagram& d = probes_[k];
+    if (w.recovery || !d.wkcOk()) continue;
+    if (w.health.condition == SlaveCondition::kOperational) continue;
+    if (w.health.condition == SlaveCondition::kFailed && cycle < w.retryAt) continue;
+    const std::uint16_t station = readLe16(d.data(), 0);
+    if (station == slaveInfos_[i].station) continue;  // the status read will see it
+    event(MasterEventKind::kSlaveReset, i, cycle, now,
+          "answers at its position with station address " + std::to_string(station) +
+              " (power cycle)");
+    startRecovery(i, SlaveRecoveryTask::Stage::kAddress, now);
+    changed = true;
+  }
+  if (changed) updateExpectations();
+}
+
+void HealthMonitor::startRecovery(std::size_t position, SlaveRecoveryTask::Stage first,
+                                  SimTime now) {
+  Watch& w = slaves_[position];
+  w.health.condition = SlaveCondition::kRecovering;
+  w.recovery =
+      std::make_unique<SlaveRecoveryTask>(transport_, slaveInfos_[position], layout_, state_);
+  w.recovery->start(first, now, options_.recoveryTimeout);
+}
+
+void HealthMonitor::updateExpectations() {
+  for (std::size_t i = 0; i < layout_.datagrams.size(); ++i) {
+    const LogicalDatagram& d = layout_.datagrams[i];
+    std::uint16_t sure = 0;
+    std::uint16_t maybe = 0;
+    for (const auto& sl : layout_.slaves) {
+      if (sl.position >= slaves_.size()) continue;
+      const std::uint16_t c = contribution(layout_, d, sl);
+      if (c == 0) continue;
+      switch (slaves_[sl.position].health.condition) {
+        case SlaveCondition::kOperational:
+          sure = static_cast<std::uint16_t>(sure + c);
+          break;
+        case SlaveCondition::kRecovering:
+        case SlaveCondition::kFailed:
+          maybe = static_cast<std::uint16_t>(maybe + c);
+          break;
+        case SlaveCondition::kLost:
+          break;
+      }
+    }
+    cyclic_.setExpectedWkc(i, sure, static_cast<std::uint16_t>(sure + maybe));
+  }
+}
+
+MasterHealth HealthMonitor::health(const TransportCounters& transport) const {
+  MasterHealth h;
+  const CyclicStatistics& st = cyclic_.statistics();
+  h.cycles = st.cycles;
+  h.framesLost = st.framesLost;
+  h.framesLate = st.framesLate + transport.framesLate;
+  h.wkcErrors = st.wkcErrors;
+  h.cyclesWithErrors = st.cyclesWithErrors;
+  h.slavesLost = slavesLost_;
+  h.slavesRecovered = slavesRecovered_;
+  h.slaves.reserve(slaves_.size());
+  for (const auto& w : slaves_) h.slaves.push_back(w.health);
+  return h;
+}
+
+}  // namespace ecsim::master
