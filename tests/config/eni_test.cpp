@@ -213,7 +213,7 @@ TEST(EniTest, FormatEniReadsBackToTheSameConfiguration) {
     EXPECT_EQ(a.previousPorts.size(), b.previousPorts.size());
     EXPECT_EQ(a.dcCapable, b.dcCapable);
   }
-  EXPECT_EQ(again->slaves[4].mailbox->coeInitCmds.at(0).index, 0x6060);
+  EXPECT_EQ(again->slaves[4].mailbox->coeInitCmds.at(0).index, 0x6065);
   EXPECT_EQ(again->cyclic.at(0).frames.at(0).cmds.at(0).state, "SAFEOP OP");
   EXPECT_EQ(again->processImage.inputs.size(), eni->processImage.inputs.size());
   // Text that needs escaping survives.
