@@ -21,6 +21,7 @@
 #include "link/veth_setup.hpp"
 #include "slavesim/generic_slave.hpp"
 #include "tools/ecsim/commands.hpp"
+#include "tools/ecsim/status_view.hpp"
 #include "topology/network_builder.hpp"
 #include "topology/network_server.hpp"
 #include "topology/pcap_cable_tap.hpp"
@@ -40,6 +41,8 @@ struct ServeOptions {
   bool paced{false};
   bool quiet{false};
   bool realtime{false};
+  bool status{false};      // live table on the terminal
+  std::string statusJson;  // status rewritten periodically to this file
 };
 
 // The built-in demo network: the installed copy, else the one in the source tree.
@@ -175,7 +178,11 @@ int runServe(ServeOptions o) {
                o.pcap.empty() ? "" : fmt::format(", capturing to {}", o.pcap));
     std::fflush(stdout);
   }
-  auto status = server.run([&] { return stop.raised(); });
+  StatusReporter reporter(o.status, o.statusJson);
+  auto status = server.run([&] {
+    reporter.tick(clock.now(), segment, server.counters());
+    return stop.raised();
+  });
   for (auto& w : writers) (void)w->close();
   const auto& c = server.counters();
   const auto& sc = segment.counters();
@@ -210,6 +217,9 @@ CommandRunner addServeCommand(CLI::App& app) {
   cmd->add_flag("--paced", opts->paced, "Answer at the modelled round-trip time");
   cmd->add_flag("--quiet", opts->quiet, "Print only the final statistics");
   cmd->add_flag("--rt", opts->realtime, "Run with SCHED_FIFO priority and locked memory");
+  cmd->add_flag("--status", opts->status, "Show a live status table (redrawn twice a second)");
+  cmd->add_option("--status-json", opts->statusJson,
+                  "Rewrite the status to FILE (JSON) twice a second");
   return [opts] { return runServe(*opts); };
 }
 
