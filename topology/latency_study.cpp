@@ -6,6 +6,7 @@
 
 #include "protocol/frame.hpp"
 #include "protocol/registers.hpp"
+#include "slavesim/esc_type.hpp"
 #include "slavesim/generic_slave.hpp"
 #include "topology/segment.hpp"
 
@@ -32,20 +33,26 @@ void programFmmus(slavesim::Esc& esc, std::uint32_t logical, std::uint16_t bytes
 }
 
 Status wire(Segment& seg, const StudyParameters& p) {
+  // A coupler is slave 0 and the slaves with process data follow it on its port 1.
+  const std::size_t first = p.coupler ? 1 : 0;
   const std::size_t n = p.slaves;
+  if (p.coupler) ECSIM_TRY(seg.connect(0, 1, 1, 0, p.cableMetres));
   if (p.topology == StudyTopology::kLine) {
-    for (std::size_t i = 1; i < n; ++i) ECSIM_TRY(seg.connect(i - 1, 1, i, 0, p.cableMetres));
+    for (std::size_t i = 1; i < n; ++i) {
+      ECSIM_TRY(seg.connect(first + i - 1, 1, first + i, 0, p.cableMetres));
+    }
     return okStatus();
   }
   // Tree: junctions every kTreeGroup slaves along a trunk (port 1 -> port 0); each junction's
   // port 3 carries a branch line of the following slaves.
   for (std::size_t i = 1; i < n; ++i) {
+    const std::size_t at = first + i;
     if (i % kTreeGroup == 0) {
-      ECSIM_TRY(seg.connect(i - kTreeGroup, 1, i, 0, p.cableMetres));
+      ECSIM_TRY(seg.connect(at - kTreeGroup, 1, at, 0, p.cableMetres));
     } else if (i % kTreeGroup == 1) {
-      ECSIM_TRY(seg.connect(i - 1, 3, i, 0, p.cableMetres));
+      ECSIM_TRY(seg.connect(at - 1, 3, at, 0, p.cableMetres));
     } else {
-      ECSIM_TRY(seg.connect(i - 1, 1, i, 0, p.cableMetres));
+      ECSIM_TRY(seg.connect(at - 1, 1, at, 0, p.cableMetres));
     }
   }
   return okStatus();
@@ -67,8 +74,11 @@ std::vector<std::size_t> logSpacedCounts(std::size_t max) {
 SimTime closedFormLineRoundTrip(const StudyParameters& p, std::size_t frameBytes) {
   const auto n = static_cast<SimTime>(p.slaves);
   const auto cable = [](double m) { return static_cast<SimTime>(m * 5.0 + 0.5); };
-  const SimTime firstBit = n * p.processingDelayNs + (n - 1) * p.forwardingDelayNs +
-                           2 * (n - 1) * cable(p.cableMetres) + 2 * cable(p.masterCableMetres);
+  SimTime firstBit = n * p.processingDelayNs + (n - 1) * p.forwardingDelayNs +
+                     2 * (n - 1) * cable(p.cableMetres) + 2 * cable(p.masterCableMetres);
+  if (p.coupler) {
+    firstBit += p.couplerProcessingDelayNs + p.couplerForwardingDelayNs + 2 * cable(p.cableMetres);
+  }
   return firstBit +
          static_cast<SimTime>(8 + std::max<std::size_t>(frameBytes, kMinFrameSize) + 4) * 80;
 }
@@ -78,31 +88,37 @@ Result<StudyPoint> runLatencyPoint(const StudyParameters& p, const Clock& cpuClo
     return makeError(ErrorCode::kInvalidArgument, "study needs at least one slave and one byte");
   }
   Segment seg;
+  if (p.coupler) {
+    seg.addSlave(slavesim::makeGenericSlave("coupler", 0));
+    seg.setDelays(0, p.couplerProcessingDelayNs, p.couplerForwardingDelayNs);
+  }
   for (std::size_t i = 0; i < p.slaves; ++i) {
-    seg.addSlave(
-        slavesim::makeGenericSlave("s" + std::to_string(i), static_cast<std::uint32_t>(i)));
-    seg.setDelays(i, p.processingDelayNs, p.forwardingDelayNs);
-    programFmmus(seg.slave(i).esc(), static_cast<std::uint32_t>(i * p.bytesPerSlave),
+    const std::size_t at = seg.addSlave(
+        slavesim::makeGenericSlave("s" + std::to_string(i), static_cast<std::uint32_t>(i + 1)));
+    seg.setDelays(at, p.processingDelayNs, p.forwardingDelayNs);
+    programFmmus(seg.slave(at).esc(), static_cast<std::uint32_t>(i * p.bytesPerSlave),
                  p.bytesPerSlave);
   }
   ECSIM_TRY(wire(seg, p));
   seg.setMasterCable(p.masterCableMetres);
   seg.slave(0).esc().pdiWrite16(reg::kConfiguredStationAddress.address, 0x1001);
 
-  // The cyclic frames: LRW pieces of the image, the FRMW 0x0910 in the first frame.
+  // The cyclic frames: LRW pieces of the image, the FRMW 0x0910 in the first frame (the
+  // reference clock is the first slave, coupler included, as masters choose it).
   const std::size_t image = p.slaves * p.bytesPerSlave;
   const std::size_t room = kMaxFrameSize - kEthernetHeaderSize - kEtherCatHeaderSize;
   std::vector<std::array<std::uint8_t, kMaxFrameSize>> frames;
   std::vector<std::size_t> lengths;
   std::vector<std::uint16_t> expectedWkc;
   for (std::size_t off = 0; off < image;) {
-    const std::size_t dc = off == 0 ? kDatagramOverhead + 8 : 0;
+    const bool withDc = off == 0 && p.distributedClock;
+    const std::size_t dc = withDc ? kDatagramOverhead + 8 : 0;
     const std::size_t len = std::min(image - off, room - dc - kDatagramOverhead);
     frames.emplace_back();
     FrameBuilder b(frames.back(), EthernetHeader{});
     ECSIM_TRY(b.add(Command::kLrw, 0x80, static_cast<std::uint32_t>(off),
                     static_cast<std::uint16_t>(len)));
-    if (off == 0) {
+    if (withDc) {
       ECSIM_TRY(b.add(Command::kFrmw, 0x80,
                       DatagramHeader::physical(0x1001, reg::kSystemTime.address), 8));
     }
@@ -147,6 +163,52 @@ Result<StudyPoint> runLatencyPoint(const StudyParameters& p, const Clock& cpuClo
   point.simCpuNsPerCycle = static_cast<double>(cpuClock.now() - cpuStart) / p.repetitions;
   point.minCycleNs = std::max(point.roundTripNs, wireOccupancy);
   return point;
+}
+
+namespace {
+
+// EBUS terminals side by side behind an EK1100-like coupler (100BASE-TX in, EBUS out): the
+// coupler's processing passage is PHY receive + an EBUS passage, its forwarding passage an
+// EBUS passage + PHY transmit (slavesim/esc_type.hpp). No DC datagram: the figures are about
+// process data.
+StudyParameters terminalsBehindCoupler(std::size_t terminals, std::uint16_t bytes) {
+  StudyParameters p;
+  p.slaves = terminals;
+  p.bytesPerSlave = bytes;
+  p.cableMetres = 0.0;
+  p.masterCableMetres = 1.0;
+  p.processingDelayNs = slavesim::kPassageEbusNs;
+  p.forwardingDelayNs = slavesim::kPassageEbusNs;
+  p.distributedClock = false;
+  p.coupler = true;
+  p.couplerProcessingDelayNs = slavesim::kPhyReceiveNs + slavesim::kPassageEbusNs;
+  p.couplerForwardingDelayNs = slavesim::kPassageEbusNs + slavesim::kPhyTransmitNs;
+  p.repetitions = 2;
+  return p;
+}
+
+constexpr std::string_view kHighlights =
+    "Beckhoff Information System, EtherCAT highlights "
+    "(infosys.beckhoff.com/content/1033/b110_ethercat_optioninterface/1979661579.html)";
+
+}  // namespace
+
+std::vector<PublishedFigure> publishedFigures() {
+  // One digital I/O is one bit of the image (1486 bytes ~ 12,000 I/O in the same source), so
+  // 16-channel digital terminals carry 2 bytes; 4-channel 16-bit analog terminals 8 bytes.
+  return {
+      {"256 digital I/O", "coupler + 16 x 16-channel digital EBUS terminals (32 B)", kHighlights,
+       12 * kNsPerUs, terminalsBehindCoupler(16, 2)},
+      {"1000 digital I/O", "coupler + 63 x 16-channel digital EBUS terminals (126 B)", kHighlights,
+       30 * kNsPerUs, terminalsBehindCoupler(63, 2)},
+      {"200 analog I/O (16 bit)", "coupler + 50 x 4-channel analog EBUS terminals (400 B)",
+       kHighlights, 50 * kNsPerUs, terminalsBehindCoupler(50, 8)},
+      {"100 servo axes, 8 B in + out each", "coupler + 100 EBUS servo terminals, 8 B each (800 B)",
+       kHighlights, 100 * kNsPerUs, terminalsBehindCoupler(100, 8)},
+      {"12,000 digital I/O (one full frame)",
+       "coupler + 743 x 16-channel digital EBUS terminals (1486 B)", kHighlights, 350 * kNsPerUs,
+       terminalsBehindCoupler(743, 2)},
+  };
 }
 
 }  // namespace ecsim::topology

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "protocol/result.hpp"
@@ -18,12 +19,19 @@ std::string_view toString(StudyTopology t);
 
 struct StudyParameters {
   StudyTopology topology{StudyTopology::kLine};
-  std::size_t slaves{1};
+  std::size_t slaves{1};           // slaves with process data (a coupler is not counted)
   std::uint16_t bytesPerSlave{8};  // inputs and outputs overlap in the logical image (LRW)
-  double cableMetres{1.0};         // between slaves
+  double cableMetres{1.0};         // between slaves (0 for EBUS terminals side by side)
   double masterCableMetres{1.0};
   SimTime processingDelayNs{1000};
   SimTime forwardingDelayNs{1000};
+  // The DC FRMW of 0x0910 in the first frame (a master running distributed clocks).
+  bool distributedClock{true};
+  // A coupler without process data ahead of the slaves (an EK1100 in front of EBUS terminals):
+  // port 0 is 100BASE-TX, its other side EBUS, so its two passages differ.
+  bool coupler{false};
+  SimTime couplerProcessingDelayNs{0};
+  SimTime couplerForwardingDelayNs{0};
   int repetitions{20};  // cycles simulated to measure CPU time
 };
 
@@ -42,8 +50,20 @@ Result<StudyPoint> runLatencyPoint(const StudyParameters& p, const Clock& cpuClo
 
 // Round trip of one frame of `frameBytes` Ethernet bytes through a line of identical slaves,
 // from the timing model's formula: N processing delays, N-1 forwarding delays, each cable
-// twice, then the frame's own wire time (preamble + frame + FCS at 80 ns/byte).
+// twice, then the frame's own wire time (preamble + frame + FCS at 80 ns/byte). A coupler adds
+// both its delays and one more cable, crossed twice.
 SimTime closedFormLineRoundTrip(const StudyParameters& p, std::size_t frameBytes);
+
+// A published EtherCAT performance figure and the network we reproduce it with
+// (docs/timing.md, "Published figures").
+struct PublishedFigure {
+  std::string_view name;     // e.g. "1000 digital I/O"
+  std::string_view network;  // the modelled network, in words
+  std::string_view source;
+  SimTime publishedNs{0};
+  StudyParameters parameters;
+};
+std::vector<PublishedFigure> publishedFigures();
 
 // Slave counts 1, 2, 4, ... up to max (max included).
 std::vector<std::size_t> logSpacedCounts(std::size_t max);

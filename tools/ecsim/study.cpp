@@ -23,7 +23,40 @@ struct StudyOptions {
   SimTime processingNs{1000};
   SimTime forwardingNs{1000};
   double cableMetres{1.0};
+  std::string preset;  // "published": the published EtherCAT figures instead of the sweep
 };
+
+// `--preset published`: each published figure with the network that reproduces it
+// (topology::publishedFigures, docs/timing.md), into published.csv; fails when one is off by
+// more than 10 %.
+int runPublished(const StudyOptions& o) {
+  std::filesystem::create_directories(o.out);
+  std::ofstream csv(std::filesystem::path(o.out) / "published.csv");
+  csv << "figure,network,slaves,bytes_per_slave,frame_bytes,modelled_round_trip_ns,published_ns,"
+         "deviation_percent,closed_form_ns,source\n";
+  RealClock cpu;
+  bool allWithin = true;
+  for (const auto& f : topology::publishedFigures()) {
+    auto point = topology::runLatencyPoint(f.parameters, cpu);
+    if (!point.ok()) {
+      fmt::print(stderr, "ecsim study: {}: {}\n", f.name, point.error().message());
+      return 1;
+    }
+    const double deviation =
+        100.0 * (static_cast<double>(point->roundTripNs) - static_cast<double>(f.publishedNs)) /
+        static_cast<double>(f.publishedNs);
+    allWithin = allWithin && deviation > -10.0 && deviation < 10.0;
+    csv << fmt::format(
+        "\"{}\",\"{}\",{},{},{},{},{},{:.1f},{},\"{}\"\n", f.name, f.network, f.parameters.slaves,
+        f.parameters.bytesPerSlave, point->frameBytes, point->roundTripNs, f.publishedNs, deviation,
+        topology::closedFormLineRoundTrip(f.parameters, point->frameBytes), f.source);
+    fmt::print("{:36} {:8.1f} us (published {:5.0f} us, {:+5.1f} %)  {}\n", f.name,
+               static_cast<double>(point->roundTripNs) / 1000.0,
+               static_cast<double>(f.publishedNs) / 1000.0, deviation, f.network);
+  }
+  fmt::print("wrote {}/published.csv\n", o.out);
+  return allWithin ? 0 : 1;
+}
 
 const char* kPlot =
     R"(# gnuplot script written by `ecsim study latency`; edit and rerun: gnuplot latency.gp
@@ -41,6 +74,11 @@ set style data linespoints
 )";
 
 int runStudy(const StudyOptions& o) {
+  if (o.preset == "published") return runPublished(o);
+  if (!o.preset.empty()) {
+    fmt::print(stderr, "ecsim study: unknown preset '{}' (published)\n", o.preset);
+    return 2;
+  }
   std::filesystem::create_directories(o.out);
   const auto dir = std::filesystem::path(o.out);
   std::ofstream csv(dir / "latency.csv");
@@ -128,6 +166,8 @@ CommandRunner addStudyCommand(CLI::App& app) {
   latency->add_option("--processing-ns", opts->processingNs, "ESC processing delay");
   latency->add_option("--forwarding-ns", opts->forwardingNs, "ESC forwarding delay");
   latency->add_option("--cable", opts->cableMetres, "Cable length between slaves in metres");
+  latency->add_option("--preset", opts->preset,
+                      "'published': reproduce the published EtherCAT figures (published.csv)");
   return [opts] { return runStudy(*opts); };
 }
 
