@@ -31,6 +31,7 @@ Status CyclicExchange::build(const ProcessImageLayout& layout, const MacAddress&
   expectedMax_.clear();
   statistics_ = {};
   lastSend_.reset();
+  dcDatagram_.reset();
   EthernetHeader ethernet;
   ethernet.destination = kBroadcastMac;
   ethernet.source = source;
@@ -43,6 +44,12 @@ Status CyclicExchange::build(const ProcessImageLayout& layout, const MacAddress&
       auto view = builder.add(Command::kLrw, 0, d.logicalStart, d.length);
       if (!view.ok()) return view.takeError();
       datagrams_.push_back({f, k++});
+    }
+    if (f == 0 && dcReference_) {
+      auto view = builder.add(Command::kFrmw, 0, DatagramHeader::physical(*dcReference_, 0x0910),
+                              std::uint16_t{8});
+      if (!view.ok()) return view.takeError();
+      dcDatagram_ = k++;
     }
     auto length = builder.finish();
     if (!length.ok()) return length.takeError();
@@ -117,6 +124,14 @@ bool CyclicExchange::pending() const {
     if (frame->pending()) return true;
   }
   return false;
+}
+
+std::optional<std::uint64_t> CyclicExchange::dcSystemTime() const {
+  if (!dcDatagram_ || frames_.empty() || frames_[0]->state() != DatagramState::kReceived) {
+    return std::nullopt;
+  }
+  const std::size_t at = frames_[0]->datagramOffset(*dcDatagram_) + kDatagramHeaderSize;
+  return readLe64(frames_[0]->rx(), at);
 }
 
 CycleResult CyclicExchange::finish(Bytes image) {

@@ -98,6 +98,13 @@ class CyclicExchange {
     lastSend_.reset();
   }
 
+  // Distributed clocks (master/dc.hpp): with a reference clock's station address, build()
+  // appends to the first frame an FRMW of its system time 0x0910 (8 bytes), so every cycle
+  // distributes the reference time and drives the slaves' drift control loops. nullopt: none.
+  void setDcReference(std::optional<std::uint16_t> station) { dcReference_ = station; }
+  // The reference clock's system time carried back by the last answered frame.
+  std::optional<std::uint64_t> dcSystemTime() const;
+
   // The WKCs a datagram is accepted with: the layout's expected value, unless widened or
   // lowered (recovery does, while slaves are missing or being reconfigured);
   // resetExpectedWkcs() restores the layout's values.
@@ -133,6 +140,8 @@ class CyclicExchange {
   SimTime period_{0};
   SimTime deadline_{0};
   std::optional<SimTime> lastSend_;
+  std::optional<std::uint16_t> dcReference_;
+  std::optional<std::size_t> dcDatagram_;  // index of the FRMW in frame 0
 };
 
 }  // namespace ecsim::master
