@@ -104,6 +104,14 @@ Result<TopologySlave> parseSlave(const xml::Context& ctx, const Element* e,
     input.value = *value;
     s.inputs.push_back(input);
   }
+  for (const Element* param : xml::Children(e, "Param")) {
+    const char* pname = param->Attribute("name");
+    const char* value = param->Attribute("value");
+    if (pname == nullptr || value == nullptr) {
+      return ctx.error(param, "Param needs name and value attributes");
+    }
+    s.params.push_back({pname, value, param->GetLineNum()});
+  }
   return s;
 }
 

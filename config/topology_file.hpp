@@ -22,6 +22,12 @@ struct TopologyInput {  // an initial input value: object entry and value
   int line{0};
 };
 
+struct TopologyParam {  // a device model parameter (<Param name= value=>)
+  std::string name;
+  std::string value;
+  int line{0};
+};
+
 struct TopologySlave {
   std::string name;
   // Device: from an ESI file (esiFile + productCode [+ revision]) or a built-in one.
@@ -38,6 +44,7 @@ struct TopologySlave {
   double driftPpm{0.0};
   std::vector<TopologyInput> inputs;
   std::filesystem::path stateFile;  // persistent device state (e.g. absolute encoder)
+  std::vector<TopologyParam> params;  // device model parameters, in the written order
   int line{0};
 };
 

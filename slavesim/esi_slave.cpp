@@ -70,8 +70,8 @@ Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiDevice& device, std::st
   pd->setVirtualSyncManagers(virtualSms);
   pd->updateProfile(profile);
   if (options.deviceModels) {
-    devices::DeviceModelOptions modelOptions;
-    modelOptions.stateFile = options.stateFile;
+    devices::DeviceModelOptions modelOptions = options.models;
+    if (!options.stateFile.empty()) modelOptions.stateFile = options.stateFile;
     ECSIM_TRY(devices::attachDeviceModel(
         *pd,
         devices::deviceModelFor(sii.identity.vendorId, sii.identity.productCode, device.profileNo),
@@ -89,6 +89,10 @@ Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiDevice& device, std::st
     slave->setMailboxServer(std::make_unique<coe::CoeServer>(od, coeOptions));
   }
   slave->setDevice(std::move(pd));
+  if (devices::Cia402Drive* drive = devices::driveOf(*slave);
+      drive != nullptr && !options.models.emergencies) {
+    drive->setEmergencySink(emergencySinkOf(*slave));
+  }
   return slave;
 }
 
@@ -109,6 +113,12 @@ coe::ObjectDictionary* objectDictionaryOf(Slave& slave) {
 
 coe::CoeServer* coeServerOf(Slave& slave) {
   return dynamic_cast<coe::CoeServer*>(slave.mailboxServer());
+}
+
+devices::EmergencySink emergencySinkOf(Slave& slave) {
+  coe::CoeServer* server = coeServerOf(slave);
+  if (server == nullptr) return {};
+  return [server](const Emergency& e) { server->pushEmergency(e); };
 }
 
 }  // namespace ecsim::slavesim

@@ -25,6 +25,7 @@
 #include "protocol/sii.hpp"
 #include "slavesim/coe/coe_server.hpp"
 #include "slavesim/coe/object_dictionary.hpp"
+#include "slavesim/devices/device_models.hpp"
 #include "slavesim/esc_type.hpp"
 #include "slavesim/process_data.hpp"
 #include "slavesim/slave.hpp"
@@ -39,8 +40,12 @@ struct EsiSlaveOptions {
   bool deviceNameFirst{true};
   // Attach the device model devices::deviceModelFor() names (false: plain process data).
   bool deviceModels{true};
-  // Persistent device state (a drive's shaft position), TopologySlave::stateFile.
+  // Persistent device state (a drive's shaft position), TopologySlave::stateFile; when set it
+  // wins over models.stateFile.
   std::filesystem::path stateFile;
+  // Parameters of the device model (devices/device_params.hpp). A drive's emergencies go to
+  // the slave's CoE server unless models.emergencies is set.
+  devices::DeviceModelOptions models;
 };
 
 // ET1100 by default. A LAN9252-class ESC (4 SMs, 3 FMMUs, 2 ports, 4 KB process RAM) when
@@ -58,5 +63,8 @@ Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiFile& file, const EsiDe
 ProcessDataDevice* processDataDeviceOf(Slave& slave);
 coe::ObjectDictionary* objectDictionaryOf(Slave& slave);
 coe::CoeServer* coeServerOf(Slave& slave);
+// A sink that queues emergencies on the slave's CoE server (empty without one), for
+// devices::attachDeviceModel when a model is re-created (a simulated power cycle).
+devices::EmergencySink emergencySinkOf(Slave& slave);
 
 }  // namespace ecsim::slavesim

@@ -152,7 +152,19 @@ void ProcessDataDevice::updateProfile(SlaveProfile& profile) {
 void ProcessDataDevice::step(Esc& esc, AlState state, SimTime now) {
   const bool exchanging = state == AlState::kSafeOp || state == AlState::kOp;
   if (exchanging) binding_.readOutputs(esc);
-  if (application_) application_->step(*od_, state, now);
+  if (application_) {
+    application_->setSyncActive(esc.syncActive(0));
+    application_->step(*od_, state, now);
+  }
+  if (exchanging) binding_.writeInputs(esc);
+}
+
+void ProcessDataDevice::sync(Esc& esc, unsigned signal, AlState state, SimTime now) {
+  if (!application_) return;
+  const bool exchanging = state == AlState::kSafeOp || state == AlState::kOp;
+  if (exchanging) binding_.readOutputs(esc);
+  application_->setSyncActive(esc.syncActive(0));
+  application_->sync(*od_, signal, state, now);
   if (exchanging) binding_.writeInputs(esc);
 }
 

@@ -81,6 +81,16 @@ class Application {
  public:
   virtual ~Application() = default;
   virtual void step(coe::ObjectDictionary& od, AlState state, SimTime now) = 0;
+  // A SYNC0/SYNC1 pulse (Device::sync), between the same output and input copies. While
+  // syncActive() an application synchronised to DC does its cycle here rather than in step().
+  virtual void sync(coe::ObjectDictionary& /*od*/, unsigned /*signal*/, AlState /*state*/,
+                    SimTime /*now*/) {}
+  // Whether the ESC generates SYNC0 (Esc::syncActive(0)), set before each step() and sync().
+  bool syncActive() const { return syncActive_; }
+  void setSyncActive(bool active) { syncActive_ = active; }
+
+ private:
+  bool syncActive_{false};
 };
 
 // The Device of a dictionary-based slave: keeps the ESM's expectations up to date (rebinding
@@ -94,6 +104,7 @@ class ProcessDataDevice final : public Device {
 
   void updateProfile(SlaveProfile& profile) override;
   void step(Esc& esc, AlState state, SimTime now) override;
+  void sync(Esc& esc, unsigned signal, AlState state, SimTime now) override;
 
   coe::ObjectDictionary& dictionary() { return *od_; }
   std::shared_ptr<coe::ObjectDictionary> sharedDictionary() { return od_; }

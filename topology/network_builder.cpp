@@ -3,6 +3,7 @@
 #include <fstream>
 
 #include "protocol/sii.hpp"
+#include "slavesim/devices/device_params.hpp"
 #include "slavesim/esi_slave.hpp"
 #include "slavesim/generic_slave.hpp"
 
@@ -77,6 +78,18 @@ Result<std::unique_ptr<slavesim::Slave>> SlaveFactory::make(const TopologySlave&
   slavesim::EsiSlaveOptions options;
   options.escType = esc;
   options.serial = static_cast<std::uint32_t>(entry.line);
+  options.stateFile = entry.stateFile;
+  if (!entry.params.empty()) {
+    if (slavesim::devices::deviceModelFor(file.vendor.id, *entry.productCode, device->profileNo) ==
+        slavesim::devices::DeviceModelKind::kNone) {
+      return at(entry, "Param given, but this device has no model of ecsim with parameters");
+    }
+    std::vector<slavesim::devices::DeviceParam> params;
+    for (const auto& p : entry.params) params.push_back({p.name, p.value, p.line});
+    if (auto s = slavesim::devices::applyDeviceParams(options.models, params); !s.ok()) {
+      return s.takeError();
+    }
+  }
   auto slave = slavesim::makeSlaveFromEsi(file, *device, entry.name, options);
   if (!slave.ok()) return slave;
   if (auto* od = slavesim::objectDictionaryOf(**slave)) {

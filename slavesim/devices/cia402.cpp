@@ -90,6 +90,30 @@ std::string_view toString(Command command) {
   return "?";
 }
 
+std::uint8_t errorRegisterFor(std::uint16_t code) {
+  if (code == kErrorReset) return 0;
+  std::uint8_t reg = 0x01;
+  switch (code >> 12) {
+    case 0x2:
+      reg |= 0x02;
+      break;
+    case 0x3:
+      reg |= 0x04;
+      break;
+    case 0x4:
+      reg |= 0x08;
+      break;
+    case 0x6:
+    case 0x7:
+    case 0x8:
+      reg |= (code >> 8) == 0x81 ? 0x10 : 0x20;
+      break;
+    default:
+      break;
+  }
+  return reg;
+}
+
 Command decodeControlword(std::uint16_t controlword, std::uint16_t previous) {
   if ((controlword & cw::kFaultReset) != 0) {
     return (previous & cw::kFaultReset) == 0 ? Command::kFaultReset : Command::kNone;

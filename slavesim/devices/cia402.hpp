@@ -56,6 +56,15 @@ inline constexpr std::uint16_t kSupportedDriveModes = 0x6502;
 // Error codes (0x603F, CiA 402 / CiA 301 emergency codes).
 inline constexpr std::uint16_t kErrorFollowing = 0x8611;      // position following error
 inline constexpr std::uint16_t kErrorCommunication = 0x8100;  // communication, generic
+inline constexpr std::uint16_t kErrorOvercurrent = 0x2310;    // continuous over current
+inline constexpr std::uint16_t kErrorEncoder = 0x7305;        // incremental sensor 1 fault
+inline constexpr std::uint16_t kErrorReset = 0x0000;          // emergency: error reset
+
+// The CiA 301 error register (0x1001) a fault with this code sets: bit 0 generic always, then
+// by the code's group: 0x2xxx current (bit 1), 0x3xxx voltage (bit 2), 0x4xxx temperature
+// (bit 3), 0x81xx communication (bit 4), other 0x6xxx-0x8xxx device profile (bit 5). 0 for
+// kErrorReset.
+std::uint8_t errorRegisterFor(std::uint16_t code);
 
 // ---- controlword and statusword bits ------------------------------------------------------------
 namespace cw {

@@ -20,6 +20,7 @@ namespace {
 constexpr SimTime kMaxCatchUp = 10 * kNsPerSecond;
 constexpr std::uint64_t kFollowingErrorOff = 0xFFFFFFFFu;
 constexpr std::int64_t kDefaultMaxTorquePerMille = 3000;
+constexpr std::uint16_t kErrorRegister = 0x1001;  // CiA 301 error register
 
 std::int32_t wrap32(std::int64_t v) {
   return static_cast<std::int32_t>(static_cast<std::uint32_t>(static_cast<std::uint64_t>(v)));
@@ -79,6 +80,10 @@ Status Cia402Drive::init() {
   obj_.feActual = ref(kFollowingErrorActualValue);
   obj_.targetVelocity = ref(kTargetVelocity);
   obj_.supportedModes = ref(kSupportedDriveModes);
+  obj_.errorRegister = ref(kErrorRegister);
+  if (params_.followingErrorWindow) obj_.feWindow.set(*params_.followingErrorWindow);
+  if (params_.followingErrorTimeoutMs) obj_.feTimeout.set(*params_.followingErrorTimeoutMs);
+  if (params_.maxTorquePerMille) obj_.maxTorque.set(*params_.maxTorquePerMille);
 
   double angle = params_.initialShaftAngle;
   if (!params_.stateFile.empty()) {
@@ -143,6 +148,16 @@ void Cia402Drive::measure() {
 }
 
 void Cia402Drive::step(coe::ObjectDictionary& /*od*/, AlState al, SimTime now) {
+  if (syncActive() && started_) return;  // the SYNC0 pulses run the drive
+  cycle(al, now);
+}
+
+void Cia402Drive::sync(coe::ObjectDictionary& /*od*/, unsigned signal, AlState al, SimTime now) {
+  if (signal != 0 || !syncActive()) return;
+  cycle(al, now);
+}
+
+void Cia402Drive::cycle(AlState al, SimTime now) {
   if (!started_) {
     started_ = true;
     lastNow_ = now;
@@ -185,6 +200,7 @@ void Cia402Drive::substep() {
   positionDemand_ = command.mode == ControlMode::kPosition;
   followingErrorValue_ = positionDemand_ ? demand_ - measured_ : 0.0;  // both at this instant
   checkFollowingError(positionDemand_ && state_ == State::kOperationEnabled);
+  if (encoder_.faulted()) raiseFault(cia402::kErrorEncoder);
   axis_.substep(command, encoder_.angleOf(static_cast<double>(reading_.counts)));
   measure();
 }
@@ -269,6 +285,7 @@ void Cia402Drive::enterState(State next) {
       if (previous == State::kFault) {
         errorCode_ = 0;  // transition 15: fault reset
         followingError_ = false;
+        emitEmergency(cia402::kErrorReset);
       }
       break;
     default:
@@ -281,6 +298,18 @@ void Cia402Drive::raiseFault(std::uint16_t code) {
   if (state_ == State::kFault || state_ == State::kFaultReactionActive) return;
   errorCode_ = code;
   enterState(cia402::powered(state_) ? State::kFaultReactionActive : State::kFault);
+  emitEmergency(code);
+}
+
+void Cia402Drive::emitEmergency(std::uint16_t code) {
+  const std::uint8_t reg = cia402::errorRegisterFor(code);
+  obj_.errorRegister.set(reg);
+  if (!emergencySink_) return;
+  Emergency e;
+  e.errorCode = code;
+  e.errorRegister = reg;
+  ++emergenciesSent_;
+  emergencySink_(e);
 }
 
 void Cia402Drive::injectFault(std::uint16_t code) {

@@ -6,7 +6,10 @@
 // substeps of the servo axis, 62.5 us at 16 kHz) under the commands taken at the previous
 // step, then takes the new outputs (controlword, mode, targets), runs the power state machine
 // and writes the inputs (statusword, actual values). So outputs a frame brings at time t act
-// from t on, and the inputs show the drive at `now`.
+// from t on, and the inputs show the drive at `now`. While the ESC generates SYNC0
+// (Application::syncActive(), DC synchronous mode) that cycle runs on each SYNC0 pulse instead
+// (sync()), so outputs act and inputs are latched at the pulses, and step() leaves the model
+// alone; without SYNC0 the drive free-runs on step() as described.
 //
 // Behaviour, in the terms of cia402.hpp:
 //  - the controlword is obeyed in OP only. Leaving OP while the power stage is on is a
@@ -26,6 +29,11 @@
 //  - following error (position modes): 0x60F4 = demand - actual; beyond 0x6065 the warning
 //    bit 7 is set, beyond it for longer than 0x6066 ms bit 13 and fault 0x8611 in 0x603F
 //    (0x6065 = 0xFFFFFFFF switches monitoring off).
+//  - faults: every fault (following error, communication 0x8100, an injected one such as
+//    over current 0x2310, and an encoder fault 0x7305 while Encoder::faulted()) sets 0x603F,
+//    the error register 0x1001 (when present; cia402::errorRegisterFor) and sends a CoE
+//    emergency (code, error register, 5 zero bytes) through the emergency sink; the fault
+//    reset sends the "error reset" emergency 0x0000.
 //  - quick stop (0x605A): 0 coast; 1/5 profile deceleration, 2/6 quick-stop deceleration,
 //    3/7 and 4/8 at the torque limit; 1-4 then Switch on disabled, 5-8 hold in Quick stop
 //    active. The fault reaction stops at the quick-stop deceleration (at most
@@ -38,9 +46,11 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 
+#include "protocol/coe.hpp"
 #include "protocol/result.hpp"
 #include "slavesim/devices/cia402.hpp"
 #include "slavesim/devices/encoder.hpp"
@@ -67,7 +77,15 @@ struct DriveParams {
   SimTime faultReactionTimeout{500 * kNsPerMs};  // longest fault reaction
   double initialShaftAngle{0.0};                 // rad, when there is no state file yet
   std::filesystem::path stateFile;               // empty: nothing kept
+  // Initial values of the dictionary's 0x6065 (counts), 0x6066 (ms) and 0x6072 (per mille);
+  // unset: the ESI defaults.
+  std::optional<std::uint32_t> followingErrorWindow;
+  std::optional<std::uint16_t> followingErrorTimeoutMs;
+  std::optional<std::uint16_t> maxTorquePerMille;
 };
+
+// Where a drive's emergency messages go (the slave's CoE server, coe::CoeServer::pushEmergency).
+using EmergencySink = std::function<void(const Emergency&)>;
 
 class Cia402Drive : public Application {
  public:
@@ -78,6 +96,8 @@ class Cia402Drive : public Application {
   ~Cia402Drive() override;
 
   void step(coe::ObjectDictionary& od, AlState state, SimTime now) override;
+  // SYNC0 (signal 0) while syncActive(): one drive cycle at the pulse. Other pulses: ignored.
+  void sync(coe::ObjectDictionary& od, unsigned signal, AlState state, SimTime now) override;
 
   cia402::State state() const { return state_; }
   std::int8_t activeMode() const { return mode_; }
@@ -95,8 +115,14 @@ class Cia402Drive : public Application {
   Encoder& encoder() { return encoder_; }
   const Encoder& encoder() const { return encoder_; }
   const DriveParams& params() const { return params_; }
-  // Raises a fault from outside (fault injection): fault reaction, then Fault with `code`.
+  // Raises a fault from outside (fault injection): fault reaction, then Fault with `code`
+  // (e.g. cia402::kErrorOvercurrent, kErrorFollowing, kErrorEncoder), with its emergency.
   void injectFault(std::uint16_t code);
+  // Encoder fault injection: while set the position freezes and the drive faults with 0x7305
+  // (again after each fault reset, until cleared).
+  void setEncoderFault(bool faulted) { encoder_.setFault(faulted); }
+  void setEmergencySink(EmergencySink sink) { emergencySink_ = std::move(sink); }
+  std::uint64_t emergenciesSent() const { return emergenciesSent_; }
   // Writes the state file now (no-op without one).
   Status saveState() const;
 
@@ -123,6 +149,8 @@ class Cia402Drive : public Application {
   };
 
   // ---- cia402_drive.cpp ----
+  void cycle(AlState al, SimTime now);
+  void emitEmergency(std::uint16_t code);
   void advance(SimTime dt);
   void substep();
   void measure();
@@ -166,8 +194,10 @@ class Cia402Drive : public Application {
     ObjectRef torqueActual, targetPosition, limitMin, limitMax, maxMotorSpeed;
     ObjectRef profileVelocity, profileAcceleration, profileDeceleration;
     ObjectRef homingMethod, homingSpeedSwitch, homingSpeedZero, homingAcceleration;
-    ObjectRef ipValue, ipIndex, feActual, targetVelocity, supportedModes;
+    ObjectRef ipValue, ipIndex, feActual, targetVelocity, supportedModes, errorRegister;
   } obj_;
+  EmergencySink emergencySink_;
+  std::uint64_t emergenciesSent_{0};
 
   cia402::State state_{cia402::State::kNotReadyToSwitchOn};
   std::int8_t mode_{0};

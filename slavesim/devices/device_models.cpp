@@ -1,5 +1,12 @@
 #include "slavesim/devices/device_models.hpp"
 
+#include <charconv>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <string_view>
+
+#include "slavesim/devices/device_params.hpp"
 #include "slavesim/generic_slave.hpp"
 
 namespace ecsim::slavesim::devices {
@@ -16,6 +23,15 @@ constexpr std::uint16_t kEncoderResolution = 0x2011;
 template <typename T>
 Status install(ProcessDataDevice& device, Result<std::unique_ptr<T>> model) {
   if (!model.ok()) return model.takeError();
+  device.setApplication(std::move(model).value());
+  return okStatus();
+}
+
+template <typename T>
+Status installDrive(ProcessDataDevice& device, Result<std::unique_ptr<T>> model,
+                    const EmergencySink& emergencies) {
+  if (!model.ok()) return model.takeError();
+  (*model)->setEmergencySink(emergencies);
   device.setApplication(std::move(model).value());
   return okStatus();
 }
@@ -49,7 +65,11 @@ Status attachDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,
   coe::ObjectDictionary& od = device.dictionary();
   DriveParams drive = options.drive;
   if (!options.stateFile.empty()) drive.stateFile = options.stateFile;
-  if (const auto cpr = od.get<std::uint32_t>(kEncoderResolution, 0); cpr.ok() && *cpr > 0) {
+  if (options.encoderResolutionSet) {
+    if (od.findEntry(kEncoderResolution, 0) != nullptr) {
+      ECSIM_TRY(od.set<std::uint32_t>(kEncoderResolution, 0, drive.encoder.countsPerRevolution));
+    }
+  } else if (const auto cpr = od.get<std::uint32_t>(kEncoderResolution, 0); cpr.ok() && *cpr > 0) {
     drive.encoder.countsPerRevolution = *cpr;
   }
   switch (kind) {
@@ -62,9 +82,9 @@ Status attachDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,
     case DeviceModelKind::kAnalogInputs:
       return install(device, AnalogInputTerminal::create(od, 2, options.analog));
     case DeviceModelKind::kCia402Drive:
-      return install(device, Cia402Drive::create(od, drive));
+      return installDrive(device, Cia402Drive::create(od, drive), options.emergencies);
     case DeviceModelKind::kRobotDrive:
-      return install(device, RobotDrive::create(od, drive));
+      return installDrive(device, RobotDrive::create(od, drive), options.emergencies);
   }
   return okStatus();
 }
@@ -92,6 +112,179 @@ DigitalOutputTerminal* digitalOutputsOf(Slave& slave) {
 
 AnalogInputTerminal* analogInputsOf(Slave& slave) {
   return dynamic_cast<AnalogInputTerminal*>(deviceModelOf(slave));
+}
+
+// ---- parameters by name (device_params.hpp) ------------------------------------------------
+namespace {
+
+Error paramError(const DeviceParam& p, const std::string& message) {
+  std::string where = p.line > 0 ? "line " + std::to_string(p.line) + ": " : std::string();
+  return makeError(ErrorCode::kInvalidArgument,
+                   where + "parameter '" + p.name + "' = '" + p.value + "': " + message);
+}
+
+Result<double> number(const DeviceParam& p, double min = -std::numeric_limits<double>::max(),
+                      double max = std::numeric_limits<double>::max()) {
+  double v = 0.0;
+  const char* begin = p.value.data();
+  const char* end = begin + p.value.size();
+  auto [ptr, ec] = std::from_chars(begin, end, v);
+  if (ec != std::errc() || ptr != end || !std::isfinite(v)) {
+    return paramError(p, "not a number");
+  }
+  if (v < min || v > max) {
+    return paramError(p, "must be within " + std::to_string(min) + " .. " + std::to_string(max));
+  }
+  return v;
+}
+
+Result<bool> flag(const DeviceParam& p) {
+  if (p.value == "1" || p.value == "true") return true;
+  if (p.value == "0" || p.value == "false") return false;
+  return paramError(p, "must be 0 or 1");
+}
+
+template <typename T>
+Result<T> integer(const DeviceParam& p, T min, T max) {
+  ECSIM_ASSIGN_OR_RETURN(double v, number(p, static_cast<double>(min), static_cast<double>(max)));
+  if (v != std::floor(v)) return paramError(p, "must be a whole number");
+  return static_cast<T>(v);
+}
+
+constexpr double kPositive = 1e-300;
+constexpr double kHuge = std::numeric_limits<double>::max();
+
+// A parameter of the motor, axis, encoder, drive or analog groups; false: not one of them.
+Result<bool> applyPlain(DeviceModelOptions& o, const DeviceParam& p) {
+  MotorParams& m = o.drive.motor;
+  const std::string_view n = p.name;
+  // Motor: physical values (positive where zero makes the model singular).
+  struct Field {
+    std::string_view name;
+    double* target;
+    double min;
+  };
+  const Field motor[] = {
+      {"motor.inertia", &m.inertia, kPositive},
+      {"motor.viscousFriction", &m.viscousFriction, 0.0},
+      {"motor.coulombFriction", &m.coulombFriction, 0.0},
+      {"motor.gravityTorque", &m.gravityTorque, -kHuge},
+      {"motor.gravityAngle", &m.gravityAngle, -kHuge},
+      {"motor.torqueConstant", &m.torqueConstant, kPositive},
+      {"motor.backEmfConstant", &m.backEmfConstant, 0.0},
+      {"motor.resistance", &m.resistance, kPositive},
+      {"motor.inductance", &m.inductance, kPositive},
+      {"motor.voltageLimit", &m.voltageLimit, kPositive},
+      {"motor.ratedTorque", &m.ratedTorque, kPositive},
+      {"drive.quickStopDeceleration", &o.drive.quickStopDeceleration, kPositive},
+      {"drive.initialShaftAngle", &o.drive.initialShaftAngle, -kHuge},
+      {"encoder.noise", &o.drive.encoder.noiseCounts, 0.0},
+      {"analog.fullScaleVolts", &o.analog.fullScaleVolts, kPositive},
+  };
+  for (const Field& f : motor) {
+    if (n != f.name) continue;
+    ECSIM_ASSIGN_OR_RETURN(*f.target, number(p, f.min));
+    return true;
+  }
+  if (n == "motor.gravityPendulum") {
+    ECSIM_ASSIGN_OR_RETURN(m.gravityPendulum, flag(p));
+  } else if (n == "axis.substepHz") {
+    ECSIM_ASSIGN_OR_RETURN(o.drive.axis.substepHz, number(p, 1000.0, 1e6));
+  } else if (n == "axis.idealCurrentLoop") {
+    ECSIM_ASSIGN_OR_RETURN(o.drive.axis.idealCurrentLoop, flag(p));
+  } else if (n == "encoder.kind") {
+    if (p.value == "incremental") {
+      o.drive.encoder.kind = EncoderKind::kIncremental;
+    } else if (p.value == "single-turn") {
+      o.drive.encoder.kind = EncoderKind::kAbsoluteSingleTurn;
+    } else if (p.value == "multi-turn") {
+      o.drive.encoder.kind = EncoderKind::kAbsoluteMultiTurn;
+    } else {
+      return paramError(p, "must be incremental, single-turn or multi-turn");
+    }
+  } else if (n == "encoder.resolution") {
+    ECSIM_ASSIGN_OR_RETURN(o.drive.encoder.countsPerRevolution,
+                           integer<std::uint32_t>(p, 1, 1u << 30));
+    o.encoderResolutionSet = true;
+  } else if (n == "encoder.multiTurnBits") {
+    ECSIM_ASSIGN_OR_RETURN(o.drive.encoder.multiTurnBits, integer<unsigned>(p, 0, 40));
+  } else if (n == "encoder.quantisation") {
+    ECSIM_ASSIGN_OR_RETURN(o.drive.encoder.quantisationStep,
+                           integer<std::uint32_t>(p, 1, 1u << 30));
+  } else if (n == "encoder.seed") {
+    ECSIM_ASSIGN_OR_RETURN(o.drive.encoder.seed, integer<std::uint64_t>(p, 0, 1ull << 52));
+  } else if (n == "drive.followingErrorWindow") {
+    ECSIM_ASSIGN_OR_RETURN(o.drive.followingErrorWindow, integer<std::uint32_t>(p, 0, 0xFFFFFFFFu));
+  } else if (n == "drive.followingErrorTimeout") {
+    ECSIM_ASSIGN_OR_RETURN(o.drive.followingErrorTimeoutMs, integer<std::uint16_t>(p, 0, 0xFFFF));
+  } else if (n == "drive.torqueLimit") {
+    ECSIM_ASSIGN_OR_RETURN(o.drive.maxTorquePerMille, integer<std::uint16_t>(p, 0, 0xFFFF));
+  } else if (n == "drive.homeOffset") {
+    ECSIM_ASSIGN_OR_RETURN(o.drive.homeOffset, integer<std::int64_t>(p, -(1ll << 52), 1ll << 52));
+  } else if (n == "drive.initTimeMs") {
+    ECSIM_ASSIGN_OR_RETURN(auto ms, integer<std::int64_t>(p, 0, 3'600'000));
+    o.drive.initTime = ms * kNsPerMs;
+  } else if (n == "drive.faultReactionTimeoutMs") {
+    ECSIM_ASSIGN_OR_RETURN(auto ms, integer<std::int64_t>(p, 0, 3'600'000));
+    o.drive.faultReactionTimeout = ms * kNsPerMs;
+  } else if (n == "analog.conversionPeriodUs") {
+    ECSIM_ASSIGN_OR_RETURN(auto us, integer<std::int64_t>(p, 1, 10'000'000));
+    o.analog.conversionPeriod = us * 1000;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+Status applyDeviceParams(DeviceModelOptions& options, const std::vector<DeviceParam>& params) {
+  double velocityHz = 100.0;
+  double currentHz = 1000.0;
+  bool anyGain = false;
+  for (const DeviceParam& p : params) {
+    if (p.name.rfind("gains.", 0) == 0) {
+      anyGain = true;
+      if (p.name == "gains.velocityHz") {
+        ECSIM_ASSIGN_OR_RETURN(velocityHz, number(p, 0.1, 1e5));
+      } else if (p.name == "gains.currentHz") {
+        ECSIM_ASSIGN_OR_RETURN(currentHz, number(p, 1.0, 1e6));
+      }
+      continue;
+    }
+    ECSIM_ASSIGN_OR_RETURN(bool known, applyPlain(options, p));
+    if (!known) return paramError(p, "unknown parameter (docs/topology.md lists them)");
+  }
+  if (!anyGain) return okStatus();
+  ServoGains g = ServoGains::tuned(options.drive.motor, velocityHz, currentHz);
+  struct Gain {
+    std::string_view name;
+    double* target;
+  };
+  const Gain gains[] = {
+      {"gains.positionKp", &g.positionKp},
+      {"gains.velocityKp", &g.velocityKp},
+      {"gains.velocityTi", &g.velocityTi},
+      {"gains.currentKp", &g.currentKp},
+      {"gains.currentTi", &g.currentTi},
+      {"gains.velocityFeedForward", &g.velocityFeedForward},
+      {"gains.accelerationFeedForward", &g.accelerationFeedForward},
+  };
+  for (const DeviceParam& p : params) {
+    if (p.name.rfind("gains.", 0) != 0 || p.name == "gains.velocityHz" ||
+        p.name == "gains.currentHz") {
+      continue;
+    }
+    bool known = false;
+    for (const Gain& gain : gains) {
+      if (p.name != gain.name) continue;
+      ECSIM_ASSIGN_OR_RETURN(*gain.target, number(p, 0.0));
+      known = true;
+    }
+    if (!known) return paramError(p, "unknown parameter (docs/topology.md lists them)");
+  }
+  options.drive.gains = g;
+  return okStatus();
 }
 
 }  // namespace ecsim::slavesim::devices

@@ -42,6 +42,10 @@ struct DeviceModelOptions {
   std::filesystem::path stateFile;  // drives: where the shaft position is kept
   DriveParams drive;                // drives: motor, loops, encoder (stateFile above wins)
   AnalogInputOptions analog;
+  // drive.encoder.countsPerRevolution was chosen (and goes into 0x2011); otherwise a
+  // dictionary with 0x2011 gives it.
+  bool encoderResolutionSet{false};
+  EmergencySink emergencies;  // drives: where their emergency messages go
 };
 
 // Attaches the model to `device` (kNone: removes any). A previous model is destroyed first, so

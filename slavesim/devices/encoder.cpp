@@ -38,6 +38,7 @@ double Encoder::angleOf(double counts) const {
 }
 
 EncoderReading Encoder::read(double shaftAngle) {
+  if (faulted_) return last_;
   double c = exactCounts(shaftAngle);
   if (params_.noiseCounts > 0.0) c += params_.noiseCounts * noise_(rng_);
   c = std::clamp(c, -kMaxCounts, kMaxCounts);
@@ -64,6 +65,7 @@ EncoderReading Encoder::read(double shaftAngle) {
       break;
     }
   }
+  last_ = r;
   return r;
 }
 

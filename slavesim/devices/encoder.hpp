@@ -10,7 +10,9 @@
 //                  switching off (the shaft angle is what a state file keeps);
 //   quantisation   the reading is floor(counts / step) * step (step = 1: every count);
 //   noise          optional Gaussian noise (standard deviation in counts) from a seeded
-//                  generator: the same seed gives the same sequence of readings.
+//                  generator: the same seed gives the same sequence of readings;
+//   fault          injected from outside (setFault): the reading freezes at its last value
+//                  and the drive reading it faults with 0x7305 until the fault is cleared.
 #pragma once
 
 #include <cstdint>
@@ -54,8 +56,14 @@ class Encoder {
   // Shaft angle (rad) at which the encoder would read `counts` (inverse of exactCounts).
   double angleOf(double counts) const;
 
+  // Fault injection: a faulted encoder reports the last reading it took before the fault.
+  void setFault(bool faulted) { faulted_ = faulted; }
+  bool faulted() const { return faulted_; }
+
  private:
   EncoderParams params_;
+  bool faulted_{false};
+  EncoderReading last_{};
   double zeroCounts_{0.0};
   std::mt19937_64 rng_;
   std::normal_distribution<double> noise_{0.0, 1.0};

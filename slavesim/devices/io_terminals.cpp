@@ -81,6 +81,15 @@ bool DigitalInputTerminal::input(unsigned channel) const {
 }
 
 void DigitalInputTerminal::step(coe::ObjectDictionary& /*od*/, AlState /*state*/, SimTime now) {
+  if (!syncActive()) latch(now);
+}
+
+void DigitalInputTerminal::sync(coe::ObjectDictionary& /*od*/, unsigned signal, AlState /*state*/,
+                                SimTime now) {
+  if (signal == 0 && syncActive()) latch(now);
+}
+
+void DigitalInputTerminal::latch(SimTime now) {
   for (Channel& c : channels_) {
     if (c.script) c.value.set(c.script->value(now) >= 0.5 ? 1 : 0);
   }
@@ -126,6 +135,16 @@ Status DigitalOutputTerminal::writeLogCsv(const std::filesystem::path& path) con
 }
 
 void DigitalOutputTerminal::step(coe::ObjectDictionary& /*od*/, AlState state, SimTime now) {
+  // With SYNC0 the outputs change at the pulses; leaving OP still makes them safe at once.
+  if (!syncActive() || state != AlState::kOp) apply(state, now);
+}
+
+void DigitalOutputTerminal::sync(coe::ObjectDictionary& /*od*/, unsigned signal, AlState state,
+                                 SimTime now) {
+  if (signal == 0 && syncActive()) apply(state, now);
+}
+
+void DigitalOutputTerminal::apply(AlState state, SimTime now) {
   std::uint32_t next = 0;
   if (state == AlState::kOp) {
     for (std::size_t c = 0; c < channels_.size(); ++c) {
@@ -201,6 +220,15 @@ void AnalogInputTerminal::convert(Channel& c, SimTime t) {
 }
 
 void AnalogInputTerminal::step(coe::ObjectDictionary& /*od*/, AlState /*state*/, SimTime now) {
+  if (!syncActive()) update(now);
+}
+
+void AnalogInputTerminal::sync(coe::ObjectDictionary& /*od*/, unsigned signal, AlState /*state*/,
+                               SimTime now) {
+  if (signal == 0 && syncActive()) update(now);
+}
+
+void AnalogInputTerminal::update(SimTime now) {
   if (!started_) {
     started_ = true;
     nextConversion_ = now;

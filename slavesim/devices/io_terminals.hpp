@@ -19,6 +19,9 @@
 //                          limit 1 and 2 (1 above, 2 below, 3 equal, 0 off), 6 error (under- or
 //                          overrange), 15 toggles with each new value. A channel without a script
 //                          is left as the dictionary holds it.
+// With SYNC0 running (Application::syncActive()) inputs are latched, conversions published and
+// outputs applied at each SYNC0 pulse (sync()) instead of at every firmware step; outputs still
+// go to their safe state at once when the slave leaves OP.
 // Channels are numbered from 1, as their subindexes are.
 #pragma once
 
@@ -51,8 +54,10 @@ class DigitalInputTerminal final : public Application {
   bool input(unsigned channel) const;
 
   void step(coe::ObjectDictionary& od, AlState state, SimTime now) override;
+  void sync(coe::ObjectDictionary& od, unsigned signal, AlState state, SimTime now) override;
 
  private:
+  void latch(SimTime now);
   struct Channel {
     ObjectRef value;
     std::optional<Signal> script;
@@ -85,8 +90,10 @@ class DigitalOutputTerminal final : public Application {
   Status writeLogCsv(const std::filesystem::path& path) const;
 
   void step(coe::ObjectDictionary& od, AlState state, SimTime now) override;
+  void sync(coe::ObjectDictionary& od, unsigned signal, AlState state, SimTime now) override;
 
  private:
+  void apply(AlState state, SimTime now);
   std::vector<ObjectRef> channels_;
   std::uint32_t outputs_{0};
   std::function<void(SimTime, std::uint32_t)> observer_;
@@ -115,8 +122,10 @@ class AnalogInputTerminal final : public Application {
   std::int16_t rawValue(double volts) const;
 
   void step(coe::ObjectDictionary& od, AlState state, SimTime now) override;
+  void sync(coe::ObjectDictionary& od, unsigned signal, AlState state, SimTime now) override;
 
  private:
+  void update(SimTime now);
   struct Channel {
     ObjectRef status, value;
     ObjectRef filterOn, limit1On, limit2On, limit1, limit2, filterMs;

@@ -1,0 +1,39 @@
+// Device model parameters by name, as a topology file gives them
+// (<Param name="motor.inertia" value="2.5e-5"/>, docs/topology.md lists every name):
+//
+//   motor.*    inertia, viscousFriction, coulombFriction, gravityTorque, gravityPendulum (0/1),
+//              gravityAngle, torqueConstant, backEmfConstant, resistance, inductance,
+//              voltageLimit, ratedTorque                                    (MotorParams, SI)
+//   gains.*    velocityHz, currentHz (the bandwidths ServoGains::tuned() uses), then the
+//              single gains positionKp, velocityKp, velocityTi, currentKp, currentTi,
+//              velocityFeedForward, accelerationFeedForward overriding the tuned ones
+//   axis.*     substepHz, idealCurrentLoop (0/1)
+//   encoder.*  kind (incremental, single-turn, multi-turn), resolution (counts per turn),
+//              multiTurnBits, quantisation (counts), noise (counts, standard deviation), seed
+//   drive.*    followingErrorWindow (counts, 0x6065), followingErrorTimeout (ms, 0x6066),
+//              torqueLimit (per mille of rated torque, 0x6072), quickStopDeceleration
+//              (counts/s^2), homeOffset (counts), initialShaftAngle (rad), initTimeMs,
+//              faultReactionTimeoutMs
+//   analog.*   fullScaleVolts, conversionPeriodUs
+// The gains are resolved after all other parameters, so their order in the file does not
+// matter. An unknown name or a value that is not a number of the right range is an error
+// naming the parameter's line.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "protocol/result.hpp"
+#include "slavesim/devices/device_models.hpp"
+
+namespace ecsim::slavesim::devices {
+
+struct DeviceParam {
+  std::string name;
+  std::string value;
+  int line{0};  // for error messages; 0: not from a file
+};
+
+Status applyDeviceParams(DeviceModelOptions& options, const std::vector<DeviceParam>& params);
+
+}  // namespace ecsim::slavesim::devices
