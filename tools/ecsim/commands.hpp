@@ -14,5 +14,7 @@ CommandRunner addDemoCommand(CLI::App& app);
 CommandRunner addNetCommand(CLI::App& app);
 CommandRunner addStudyCommand(CLI::App& app);
 CommandRunner addReplayCommand(CLI::App& app);
+CommandRunner addScenarioCommand(CLI::App& app);
+CommandRunner addCtlCommand(CLI::App& app);
 
 }  // namespace ecsim::tools

@@ -13,6 +13,8 @@ int main(int argc, char** argv) {
   auto net = ecsim::tools::addNetCommand(app);
   auto study = ecsim::tools::addStudyCommand(app);
   auto replay = ecsim::tools::addReplayCommand(app);
+  auto scenario = ecsim::tools::addScenarioCommand(app);
+  auto ctl = ecsim::tools::addCtlCommand(app);
   CLI11_PARSE(app, argc, argv);
   try {
     if (app.got_subcommand("serve")) return serve();
@@ -20,6 +22,8 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("net")) return net();
     if (app.got_subcommand("study")) return study();
     if (app.got_subcommand("replay")) return replay();
+    if (app.got_subcommand("scenario")) return scenario();
+    if (app.got_subcommand("ctl")) return ctl();
   } catch (const std::exception& e) {
     fmt::print(stderr, "ecsim: {}\n", e.what());
     return 1;

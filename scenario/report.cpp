@@ -1,0 +1,144 @@
+// Text report and JUnit XML of scenario runs. Nothing here reads a clock: the same run gives
+// the same bytes.
+#include <fmt/core.h>
+
+#include "scenario/runner.hpp"
+
+namespace ecsim::scenario {
+namespace {
+
+std::string when(const Expectation& x) {
+  if (x.atCycle) return fmt::format(" at cycle {}", *x.atCycle);
+  if (x.atTime) {
+    return fmt::format(" at {:.3f} ms", static_cast<double>(*x.atTime) / kNsPerMs);
+  }
+  return " at the end";
+}
+
+std::string valueText(double v) {
+  if (v == static_cast<double>(static_cast<std::int64_t>(v))) {
+    return std::to_string(static_cast<std::int64_t>(v));
+  }
+  return fmt::format("{:.6g}", v);
+}
+
+std::string xmlEscape(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (char c : text) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string Expectation::describe() const {
+  const std::string cmp = fmt::format("{} {}", toString(compare), valueText(value));
+  switch (kind) {
+    case ExpectKind::kState: {
+      std::string s = fmt::format("State {} is {}", slave, state);
+      if (error) s += *error ? "+ERR" : " without error";
+      if (code) s += fmt::format(" code {:#06x}", *code);
+      return s + when(*this);
+    }
+    case ExpectKind::kDetected:
+      return fmt::format("Detected {}{} within {} cycles after cycle {}", condition,
+                         slave.empty() ? "" : " of " + slave, withinCycles, afterCycle);
+    case ExpectKind::kBackInOp:
+      return fmt::format("BackInOp within {:.3f} ms after cycle {}",
+                         static_cast<double>(within) / kNsPerMs, afterCycle);
+    case ExpectKind::kRegister:
+      return fmt::format(
+          "Register {} {:#06x} ({} byte{}{}) {}{}", slave, address, width, width == 1 ? "" : "s",
+          mask == 0xFFFFFFFF ? std::string() : fmt::format(", mask {:#x}", mask), cmp, when(*this));
+    case ExpectKind::kStatistic:
+      return fmt::format("Statistic {} {}{}", name, cmp, when(*this));
+    case ExpectKind::kContinuity: {
+      std::string s = "Continuity:";
+      if (maxBadCycles != UINT64_MAX) s += fmt::format(" at most {} bad cycles", maxBadCycles);
+      if (maxConsecutiveBadCycles != UINT64_MAX) {
+        s += fmt::format(" at most {} in a row", maxConsecutiveBadCycles);
+      }
+      return s;
+    }
+    case ExpectKind::kVariable:
+      return fmt::format("Variable {} {:#06x}:{:02x} {}{}", slave, index, subindex, cmp,
+                         when(*this));
+  }
+  return "?";
+}
+
+std::string formatReport(const ScenarioResult& r) {
+  std::string out = fmt::format("scenario {} ({}), seed {}: {} cycles of {} us\n", r.name, r.file,
+                                r.seed, r.cycles, r.cycleTime / kNsPerUs);
+  for (const auto& line : r.log) out += line + "\n";
+  if (!r.error.empty()) {
+    out += fmt::format("ERROR  {}\n", r.error);
+    return out + fmt::format("result: {} did not run\n", r.name);
+  }
+  for (const auto& x : r.results) {
+    out += fmt::format("{}  {}, line {}: {}\n", x.passed ? "PASS" : "FAIL", r.file, x.line, x.what);
+    out += fmt::format("        at {:.3f} ms: {}{}\n", static_cast<double>(x.at) / kNsPerMs,
+                       x.observed, x.needsRecovery ? " [needs recovery]" : "");
+  }
+  out += fmt::format("result: {} {} ({} of {} expectations failed)\n", r.name,
+                     r.passed() ? "PASSED" : "FAILED", r.failures(), r.results.size());
+  return out;
+}
+
+std::string formatJunit(const std::vector<ScenarioResult>& results) {
+  std::size_t tests = 0, failures = 0, errors = 0;
+  for (const auto& r : results) {
+    tests += r.error.empty() ? r.results.size() : 1;
+    failures += r.failures();
+    errors += r.error.empty() ? 0 : 1;
+  }
+  std::string out = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
+  out += fmt::format(
+      "<testsuites name=\"ecsim scenarios\" tests=\"{}\" failures=\"{}\" "
+      "errors=\"{}\">\n",
+      tests, failures, errors);
+  for (const auto& r : results) {
+    out += fmt::format(
+        "  <testsuite name=\"{}\" file=\"{}\" tests=\"{}\" failures=\"{}\" "
+        "errors=\"{}\">\n",
+        xmlEscape(r.name), xmlEscape(r.file), r.error.empty() ? r.results.size() : 1, r.failures(),
+        r.error.empty() ? 0 : 1);
+    if (!r.error.empty()) {
+      out += fmt::format(
+          "    <testcase name=\"run\" classname=\"scenario.{}\">\n"
+          "      <error message=\"{}\"/>\n    </testcase>\n",
+          xmlEscape(r.name), xmlEscape(r.error));
+    }
+    for (const auto& x : r.results) {
+      out += fmt::format("    <testcase name=\"line {}: {}\" classname=\"scenario.{}\"", x.line,
+                         xmlEscape(x.what), xmlEscape(r.name));
+      if (x.passed) {
+        out += "/>\n";
+      } else {
+        out += fmt::format(">\n      <failure message=\"at {:.3f} ms: {}\"/>\n    </testcase>\n",
+                           static_cast<double>(x.at) / kNsPerMs, xmlEscape(x.observed));
+      }
+    }
+    out += "  </testsuite>\n";
+  }
+  return out + "</testsuites>\n";
+}
+
+}  // namespace ecsim::scenario

@@ -1,0 +1,58 @@
+// Runs a scenario with our master in-process on virtual time: the network from the topology,
+// the master brought to OP, then one cycle after another with the timeline's actions applied
+// at their cycle or time and the expectations checked at theirs. Everything is virtual time
+// and seeded randomness: the same scenario and seed give the same report and capture, byte for
+// byte.
+//
+// Until the master has a recovery of its own, the runner plays the application's part: after
+// a cycle with errors it reads every slave's AL state (what a master reports as lost slaves
+// and state changes) and restarts the bus (scan, configuration, OP) at most every 50 ms.
+// With recovery off it only exchanges process data.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "scenario/scenario.hpp"
+
+namespace ecsim::scenario {
+
+struct RunOptions {
+  std::optional<std::uint64_t> seed;  // overrides the file's
+  std::filesystem::path pcapDir;      // empty: no capture; else DIR/<name>.pcap
+  bool recovery{true};
+  SimTime recoveryInterval{50 * kNsPerMs};
+};
+
+struct ExpectationResult {
+  int line{0};
+  std::string what;  // "State Drive1 == OP at 2900.000 ms"
+  bool passed{false};
+  SimTime at{0};         // when it was decided, ns after OP
+  std::string observed;  // what the run showed
+  bool needsRecovery{false};
+};
+
+struct ScenarioResult {
+  std::string name;
+  std::string file;
+  std::uint64_t seed{0};
+  SimTime cycleTime{0};
+  std::uint64_t cycles{0};
+  std::vector<std::string> log;  // "  12.000 ms  cycle 12  link-down cable=drives: ..."
+  std::vector<ExpectationResult> results;
+  std::string error;  // the run could not be carried out (setup, master start)
+  bool passed() const;
+  std::size_t failures() const;
+};
+
+ScenarioResult runScenario(const Scenario& scenario, const RunOptions& options = {});
+
+// Human-readable report of one run (no wall-clock content: deterministic).
+std::string formatReport(const ScenarioResult& result);
+// JUnit XML: one testsuite per scenario, one testcase per expectation.
+std::string formatJunit(const std::vector<ScenarioResult>& results);
+
+}  // namespace ecsim::scenario

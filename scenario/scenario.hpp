@@ -1,0 +1,100 @@
+// A scenario (docs/scenarios.md): a network, the master that runs it, a timeline of fault
+// actions and the expectations a run is judged by. Read from XML; every error names the file
+// and line.
+//
+//   <Scenario name="cable_break" topology="../examples/topologies/demo.xml" cycleUs="1000"
+//             durationMs="3000" seed="1">
+//     <Master kind="in-process"/>
+//     <Timeline>
+//       <Action cycle="500" do="link-down" cable="drives"/>
+//       <Action timeMs="800" do="link-up" cable="drives"/>
+//     </Timeline>
+//     <Expect>
+//       <Detected condition="slave-state" slave="Drive1" afterCycle="500" withinCycles="100"/>
+//       <BackInOp afterCycle="800" withinMs="1000"/>
+//       <State slave="Drive1" state="OP" atMs="2900"/>
+//     </Expect>
+//   </Scenario>
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "protocol/result.hpp"
+#include "protocol/time.hpp"
+#include "topology/faults.hpp"
+
+namespace ecsim::scenario {
+
+struct TimedAction {
+  int line{0};
+  std::optional<std::uint64_t> cycle;  // cycles after the master reached OP
+  std::optional<SimTime> time;         // ns after the master reached OP
+  topology::FaultAction action;
+};
+
+enum class ExpectKind : std::uint8_t {
+  kState,       // a slave's AL state (simulator side) at a time
+  kDetected,    // the master observed a condition within N cycles of a cycle
+  kBackInOp,    // every slave in OP and a clean cycle within T of a cycle
+  kRegister,    // an ESC register (counters 0x0300-0x0313, DL status...) at a time
+  kStatistic,   // a master statistic at a time
+  kContinuity,  // bounds on cycles without fresh process data
+  kVariable,    // a process-data entry as the master sees it, at a time
+};
+
+enum class Compare : std::uint8_t { kEq, kNe, kLt, kLe, kGt, kGe };
+
+struct Expectation {
+  int line{0};
+  ExpectKind kind{ExpectKind::kState};
+  std::optional<std::uint64_t> atCycle;  // when to check (none: at the end)
+  std::optional<SimTime> atTime;
+  std::string slave;                  // topology name
+  std::string state;                  // kState: INIT/PREOP/SAFEOP/OP
+  std::optional<bool> error;          // kState: the AL status error flag
+  std::optional<std::uint16_t> code;  // kState: AL status code
+  std::string condition;              // kDetected
+  std::uint64_t afterCycle{0};        // kDetected, kBackInOp
+  std::uint64_t withinCycles{0};      // kDetected
+  SimTime within{0};                  // kBackInOp
+  std::uint16_t address{0};           // kRegister
+  unsigned width{1};                  // kRegister bytes
+  std::uint32_t mask{0xFFFFFFFF};     // kRegister: bits compared
+  std::string name;                   // kStatistic
+  std::uint16_t index{0};             // kVariable
+  std::uint8_t subindex{0};
+  bool isSigned{false};
+  Compare compare{Compare::kEq};
+  double value{0};
+  double tolerance{0};
+  std::uint64_t maxBadCycles{0};             // kContinuity
+  std::uint64_t maxConsecutiveBadCycles{0};  // kContinuity
+  bool needsRecovery{false};                 // documented: fails when the master does not react
+  std::string describe() const;
+};
+
+struct Scenario {
+  std::filesystem::path file;
+  std::string name;
+  std::string description;
+  std::filesystem::path topology;
+  std::string masterKind{"in-process"};  // or "external"
+  std::string masterCommand;             // external
+  SimTime cycleTime{kNsPerMs};
+  SimTime duration{kNsPerSecond};
+  std::uint64_t seed{1};
+  std::vector<TimedAction> actions;
+  std::vector<Expectation> expectations;
+};
+
+Result<Scenario> loadScenario(const std::filesystem::path& path);
+Result<Scenario> parseScenario(std::string_view xml, const std::filesystem::path& path);
+
+std::string_view toString(Compare c);
+bool compareValues(double observed, Compare c, double expected, double tolerance = 0);
+
+}  // namespace ecsim::scenario

@@ -1,0 +1,314 @@
+// Reads scenario files (docs/scenarios.md) with tinyxml2; errors name file and line.
+#include <tinyxml2.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "scenario/scenario.hpp"
+
+namespace ecsim::scenario {
+namespace {
+
+using tinyxml2::XMLElement;
+
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+
+  Error error(const XMLElement* e, const std::string& what) const {
+    return makeError(
+        ErrorCode::kParse,
+        file_ + ", line " + std::to_string(e == nullptr ? 0 : e->GetLineNum()) + ": " + what);
+  }
+  std::string where(const XMLElement* e) const {
+    return file_ + ", line " + std::to_string(e->GetLineNum());
+  }
+
+  static std::optional<std::string> attr(const XMLElement* e, const char* name) {
+    const char* v = e->Attribute(name);
+    if (v == nullptr) return std::nullopt;
+    return std::string(v);
+  }
+  Result<std::optional<std::uint64_t>> number(const XMLElement* e, const char* name) const {
+    auto text = attr(e, name);
+    if (!text) return std::optional<std::uint64_t>();
+    auto v = topology::parseNumber(*text);
+    if (!v) return error(e, std::string(name) + "=\"" + *text + "\" is not a number");
+    return std::optional<std::uint64_t>(*v);
+  }
+  Result<std::optional<double>> real(const XMLElement* e, const char* name) const {
+    auto text = attr(e, name);
+    if (!text) return std::optional<double>();
+    if (auto v = topology::parseNumber(*text))
+      return std::optional<double>(static_cast<double>(*v));
+    char* end = nullptr;
+    const double v = std::strtod(text->c_str(), &end);
+    if (end == text->c_str() || *end != '\0' || !std::isfinite(v)) {
+      return error(e, std::string(name) + "=\"" + *text + "\" is not a number");
+    }
+    return std::optional<double>(v);
+  }
+  Result<std::optional<SimTime>> millis(const XMLElement* e, const char* name) const {
+    ECSIM_ASSIGN_OR_RETURN(auto v, real(e, name));
+    if (!v) return std::optional<SimTime>();
+    if (*v < 0) return error(e, std::string(name) + " must not be negative");
+    return std::optional<SimTime>(static_cast<SimTime>(std::llround(*v * kNsPerMs)));
+  }
+  Result<std::optional<bool>> boolean(const XMLElement* e, const char* name) const {
+    auto text = attr(e, name);
+    if (!text) return std::optional<bool>();
+    if (*text == "true" || *text == "1") return std::optional<bool>(true);
+    if (*text == "false" || *text == "0") return std::optional<bool>(false);
+    return error(e, std::string(name) + "=\"" + *text + "\" is not true or false");
+  }
+
+ private:
+  std::string file_;
+};
+
+Result<Compare> parseCompare(const Reader& r, const XMLElement* e) {
+  const auto op = Reader::attr(e, "op").value_or("eq");
+  if (op == "eq") return Compare::kEq;
+  if (op == "ne") return Compare::kNe;
+  if (op == "lt") return Compare::kLt;
+  if (op == "le") return Compare::kLe;
+  if (op == "gt") return Compare::kGt;
+  if (op == "ge") return Compare::kGe;
+  return r.error(e, "op=\"" + op + "\" is not one of eq, ne, lt, le, gt, ge");
+}
+
+Result<TimedAction> readAction(const Reader& r, const XMLElement* e) {
+  TimedAction a;
+  a.line = e->GetLineNum();
+  ECSIM_ASSIGN_OR_RETURN(a.cycle, r.number(e, "cycle"));
+  ECSIM_ASSIGN_OR_RETURN(a.time, r.millis(e, "timeMs"));
+  if (a.cycle.has_value() == a.time.has_value()) {
+    return r.error(e, "an Action needs exactly one of cycle=\"N\" and timeMs=\"T\"");
+  }
+  auto verb = Reader::attr(e, "do");
+  if (!verb) return r.error(e, "an Action needs do=\"VERB\"");
+  a.action.verb = *verb;
+  a.action.where = r.where(e);
+  for (const auto* at = e->FirstAttribute(); at != nullptr; at = at->Next()) {
+    const std::string key = at->Name();
+    if (key == "cycle" || key == "timeMs" || key == "do") continue;
+    a.action.args[key] = at->Value();
+  }
+  const bool runnerVerb = a.action.verb == "pause-master";
+  if (!runnerVerb && !topology::FaultInjector::handles(a.action.verb)) {
+    return r.error(e, "unknown action \"" + a.action.verb + "\"");
+  }
+  return a;
+}
+
+Result<Expectation> readExpectation(const Reader& r, const XMLElement* e) {
+  Expectation x;
+  x.line = e->GetLineNum();
+  const std::string tag = e->Name();
+  ECSIM_ASSIGN_OR_RETURN(x.atCycle, r.number(e, "cycle"));
+  ECSIM_ASSIGN_OR_RETURN(x.atTime, r.millis(e, "atMs"));
+  ECSIM_ASSIGN_OR_RETURN(auto needs, r.boolean(e, "needsRecovery"));
+  x.needsRecovery = needs.value_or(false);
+  x.slave = Reader::attr(e, "slave").value_or("");
+  ECSIM_ASSIGN_OR_RETURN(x.compare, parseCompare(r, e));
+  ECSIM_ASSIGN_OR_RETURN(auto value, r.real(e, "value"));
+  ECSIM_ASSIGN_OR_RETURN(auto tolerance, r.real(e, "tolerance"));
+  x.value = value.value_or(0);
+  x.tolerance = tolerance.value_or(0);
+  auto needSlave = [&]() -> Status {
+    if (x.slave.empty()) return r.error(e, tag + " needs slave=\"NAME\"");
+    return okStatus();
+  };
+  auto needValue = [&]() -> Status {
+    if (!value) return r.error(e, tag + " needs value=\"N\"");
+    return okStatus();
+  };
+  if (tag == "State") {
+    x.kind = ExpectKind::kState;
+    ECSIM_TRY(needSlave());
+    x.state = Reader::attr(e, "state").value_or("");
+    if (x.state != "INIT" && x.state != "PREOP" && x.state != "SAFEOP" && x.state != "OP" &&
+        x.state != "BOOT") {
+      return r.error(e, "State needs state=\"INIT|PREOP|SAFEOP|OP|BOOT\"");
+    }
+    ECSIM_ASSIGN_OR_RETURN(x.error, r.boolean(e, "error"));
+    ECSIM_ASSIGN_OR_RETURN(auto code, r.number(e, "code"));
+    if (code) x.code = static_cast<std::uint16_t>(*code);
+  } else if (tag == "Detected") {
+    x.kind = ExpectKind::kDetected;
+    x.condition = Reader::attr(e, "condition").value_or("");
+    if (x.condition != "wkc-error" && x.condition != "frame-lost" && x.condition != "slave-state" &&
+        x.condition != "slave-lost" && x.condition != "emergency" && x.condition != "any-error") {
+      return r.error(e,
+                     "condition must be wkc-error, frame-lost, slave-state, slave-lost, "
+                     "emergency or any-error");
+    }
+    ECSIM_ASSIGN_OR_RETURN(auto after, r.number(e, "afterCycle"));
+    ECSIM_ASSIGN_OR_RETURN(auto within, r.number(e, "withinCycles"));
+    if (!within) return r.error(e, "Detected needs withinCycles=\"N\"");
+    x.afterCycle = after.value_or(0);
+    x.withinCycles = *within;
+  } else if (tag == "BackInOp") {
+    x.kind = ExpectKind::kBackInOp;
+    ECSIM_ASSIGN_OR_RETURN(auto after, r.number(e, "afterCycle"));
+    ECSIM_ASSIGN_OR_RETURN(auto within, r.millis(e, "withinMs"));
+    if (!within) return r.error(e, "BackInOp needs withinMs=\"T\"");
+    x.afterCycle = after.value_or(0);
+    x.within = *within;
+  } else if (tag == "Register") {
+    x.kind = ExpectKind::kRegister;
+    ECSIM_TRY(needSlave());
+    ECSIM_TRY(needValue());
+    ECSIM_ASSIGN_OR_RETURN(auto address, r.number(e, "address"));
+    ECSIM_ASSIGN_OR_RETURN(auto width, r.number(e, "width"));
+    if (!address || *address >= 0x1000)
+      return r.error(e, "Register needs address=\"0x0000-0x0FFF\"");
+    x.address = static_cast<std::uint16_t>(*address);
+    x.width = static_cast<unsigned>(width.value_or(1));
+    ECSIM_ASSIGN_OR_RETURN(auto mask, r.number(e, "mask"));
+    x.mask = static_cast<std::uint32_t>(mask.value_or(0xFFFFFFFF));
+    if (x.width != 1 && x.width != 2 && x.width != 4) return r.error(e, "width must be 1, 2 or 4");
+  } else if (tag == "Statistic") {
+    x.kind = ExpectKind::kStatistic;
+    ECSIM_TRY(needValue());
+    x.name = Reader::attr(e, "name").value_or("");
+    if (x.name.empty()) return r.error(e, "Statistic needs name=\"...\"");
+  } else if (tag == "Continuity") {
+    x.kind = ExpectKind::kContinuity;
+    ECSIM_ASSIGN_OR_RETURN(auto bad, r.number(e, "maxBadCycles"));
+    ECSIM_ASSIGN_OR_RETURN(auto run, r.number(e, "maxConsecutiveBadCycles"));
+    if (!bad && !run) {
+      return r.error(e, "Continuity needs maxBadCycles and/or maxConsecutiveBadCycles");
+    }
+    x.maxBadCycles = bad.value_or(UINT64_MAX);
+    x.maxConsecutiveBadCycles = run.value_or(UINT64_MAX);
+  } else if (tag == "Variable") {
+    x.kind = ExpectKind::kVariable;
+    ECSIM_TRY(needSlave());
+    ECSIM_TRY(needValue());
+    const auto entry = Reader::attr(e, "entry").value_or("");
+    const auto colon = entry.find(':');
+    auto index = topology::parseNumber(entry.substr(0, colon));
+    auto sub = colon == std::string::npos ? std::optional<std::uint64_t>()
+                                          : topology::parseNumber(entry.substr(colon + 1));
+    if (!index || !sub || *index > 0xFFFF || *sub > 0xFF) {
+      return r.error(e, "Variable needs entry=\"0xINDEX:SUB\"");
+    }
+    x.index = static_cast<std::uint16_t>(*index);
+    x.subindex = static_cast<std::uint8_t>(*sub);
+    ECSIM_ASSIGN_OR_RETURN(auto isSigned, r.boolean(e, "signed"));
+    x.isSigned = isSigned.value_or(false);
+  } else {
+    return r.error(e, "unknown expectation <" + tag + ">");
+  }
+  return x;
+}
+
+}  // namespace
+
+std::string_view toString(Compare c) {
+  switch (c) {
+    case Compare::kEq:
+      return "==";
+    case Compare::kNe:
+      return "!=";
+    case Compare::kLt:
+      return "<";
+    case Compare::kLe:
+      return "<=";
+    case Compare::kGt:
+      return ">";
+    case Compare::kGe:
+      return ">=";
+  }
+  return "?";
+}
+
+bool compareValues(double observed, Compare c, double expected, double tolerance) {
+  switch (c) {
+    case Compare::kEq:
+      return std::fabs(observed - expected) <= tolerance;
+    case Compare::kNe:
+      return std::fabs(observed - expected) > tolerance;
+    case Compare::kLt:
+      return observed < expected;
+    case Compare::kLe:
+      return observed <= expected;
+    case Compare::kGt:
+      return observed > expected;
+    case Compare::kGe:
+      return observed >= expected;
+  }
+  return false;
+}
+
+Result<Scenario> loadScenario(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return makeError(ErrorCode::kIo, path.string() + ": cannot open");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return parseScenario(buffer.str(), path);
+}
+
+Result<Scenario> parseScenario(std::string_view xml, const std::filesystem::path& path) {
+  Reader r(path.string());
+  tinyxml2::XMLDocument doc;
+  if (doc.Parse(xml.data(), xml.size()) != tinyxml2::XML_SUCCESS) {
+    return makeError(
+        ErrorCode::kParse,
+        path.string() + ", line " + std::to_string(doc.ErrorLineNum()) + ": " + doc.ErrorStr());
+  }
+  const XMLElement* root = doc.RootElement();
+  if (root == nullptr || std::string_view(root->Name()) != "Scenario") {
+    return r.error(root, "the root element must be <Scenario>");
+  }
+  Scenario s;
+  s.file = path;
+  s.name = Reader::attr(root, "name").value_or(path.stem().string());
+  auto topology = Reader::attr(root, "topology");
+  if (!topology) return r.error(root, "Scenario needs topology=\"PATH\"");
+  s.topology = path.parent_path() / *topology;
+  ECSIM_ASSIGN_OR_RETURN(auto cycleUs, r.number(root, "cycleUs"));
+  ECSIM_ASSIGN_OR_RETURN(auto duration, r.millis(root, "durationMs"));
+  ECSIM_ASSIGN_OR_RETURN(auto seed, r.number(root, "seed"));
+  if (cycleUs) {
+    if (*cycleUs < 50 || *cycleUs > 1000000) return r.error(root, "cycleUs must be 50..1000000");
+    s.cycleTime = static_cast<SimTime>(*cycleUs) * kNsPerUs;
+  }
+  if (duration) s.duration = *duration;
+  if (s.duration < s.cycleTime) return r.error(root, "durationMs is shorter than one cycle");
+  s.seed = seed.value_or(1);
+  if (const auto* d = root->FirstChildElement("Description"); d && d->GetText()) {
+    s.description = d->GetText();
+  }
+  if (const auto* m = root->FirstChildElement("Master")) {
+    s.masterKind = Reader::attr(m, "kind").value_or("in-process");
+    if (s.masterKind != "in-process" && s.masterKind != "external") {
+      return r.error(m, "Master kind must be in-process or external");
+    }
+    s.masterCommand = Reader::attr(m, "command").value_or("");
+    if (s.masterKind == "external" && s.masterCommand.empty()) {
+      return r.error(m, "an external Master needs command=\"...\"");
+    }
+  }
+  if (const auto* t = root->FirstChildElement("Timeline")) {
+    for (const auto* e = t->FirstChildElement(); e != nullptr; e = e->NextSiblingElement()) {
+      if (std::string_view(e->Name()) != "Action") {
+        return r.error(e, "the Timeline holds <Action> elements only");
+      }
+      ECSIM_ASSIGN_OR_RETURN(auto a, readAction(r, e));
+      s.actions.push_back(std::move(a));
+    }
+  }
+  if (const auto* x = root->FirstChildElement("Expect")) {
+    for (const auto* e = x->FirstChildElement(); e != nullptr; e = e->NextSiblingElement()) {
+      ECSIM_ASSIGN_OR_RETURN(auto exp, readExpectation(r, e));
+      s.expectations.push_back(std::move(exp));
+    }
+  }
+  if (s.expectations.empty()) return r.error(root, "a scenario needs at least one expectation");
+  return s;
+}
+
+}  // namespace ecsim::scenario
