@@ -56,7 +56,8 @@ install(TARGETS ${ecsim_install_targets} EXPORT ecsimTargets
 install(EXPORT ecsimTargets NAMESPACE ecsim:: DESTINATION ${ecsim_install_cmakedir})
 
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/ecsimConfig.cmake.in
-  ${PROJECT_BINARY_DIR}/ecsimConfig.cmake INSTALL_DESTINATION ${ecsim_install_cmakedir})
+  ${PROJECT_BINARY_DIR}/ecsimConfig.cmake INSTALL_DESTINATION ${ecsim_install_cmakedir}
+  PATH_VARS CMAKE_INSTALL_DATADIR)
 write_basic_package_version_file(${PROJECT_BINARY_DIR}/ecsimConfigVersion.cmake
   VERSION ${PROJECT_VERSION} COMPATIBILITY SameMinorVersion)
 install(FILES ${PROJECT_BINARY_DIR}/ecsimConfig.cmake ${PROJECT_BINARY_DIR}/ecsimConfigVersion.cmake
@@ -76,3 +77,13 @@ install(FILES ${PROJECT_BINARY_DIR}/ecsim.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}
 # A starting point for users: the stand-alone project our package test builds.
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/examples/user-project
         DESTINATION ${CMAKE_INSTALL_DATADIR}/ecsim/examples)
+
+# Everything `cmake --install` copies, so tests/package can bring a build tree up to date
+# before installing it (a no-op after a full build).
+add_custom_target(ecsim_install_deps)
+add_dependencies(ecsim_install_deps ${ecsim_install_targets})
+foreach(tool ecsim ecmaster)
+  if(TARGET ${tool})
+    add_dependencies(ecsim_install_deps ${tool})
+  endif()
+endforeach()

@@ -17,6 +17,8 @@ function(run what)
   message(STATUS "${what}: ok")
 endfunction()
 
+# Headers and libraries must match: bring what is installed up to date first.
+run("build what is installed" ${CMAKE_COMMAND} --build ${ECSIM_BINARY_DIR} --target ecsim_install_deps)
 run("install into ${prefix}" ${CMAKE_COMMAND} --install ${ECSIM_BINARY_DIR} --prefix ${prefix})
 foreach(f lib/cmake/ecsim/ecsimConfig.cmake lib/cmake/ecsim/ecsimConfigVersion.cmake
           lib/pkgconfig/ecsim.pc include/ecsim/protocol/result.hpp
