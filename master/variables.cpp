@@ -14,6 +14,16 @@ std::string hexIndex(std::uint16_t index, std::uint8_t subindex) {
   return buf;
 }
 
+// The SII's order string ("ECS1008", "EL2004"): short, without spaces; else the device name.
+std::string siiName(const SlaveInfo& slave) {
+  const auto& general = slave.siiContents.general;
+  if (general && general->orderIndex != 0) {
+    const std::string_view order = slave.siiContents.string(general->orderIndex);
+    if (!order.empty()) return std::string(order);
+  }
+  return slave.name;
+}
+
 bool isSigned(VariableType t) {
   return t == VariableType::kInt8 || t == VariableType::kInt16 || t == VariableType::kInt32 ||
          t == VariableType::kInt64;
@@ -188,7 +198,7 @@ std::vector<VariableInfo> nameVariables(const ProcessImageLayout& layout,
   std::vector<std::string> names(slaves.size());
   std::map<std::string, int> uses;
   for (std::size_t i = 0; i < slaves.size(); ++i) {
-    names[i] = i < slaveNames.size() && !slaveNames[i].empty() ? slaveNames[i] : slaves[i].name;
+    names[i] = i < slaveNames.size() && !slaveNames[i].empty() ? slaveNames[i] : siiName(slaves[i]);
     if (names[i].empty()) names[i] = "Slave" + std::to_string(i);
     ++uses[names[i]];
   }

@@ -2,7 +2,8 @@
 // "<slave>.<entry>" ("Drive1.Statusword", "DI1.Input 3"), like the pins of a LinuxCNC HAL
 // component, with typed access to the bits it occupies in the process image.
 //
-//   slave  the name the configuration gives the slave, else its SII name; when several
+//   slave  the name the configuration gives the slave, else its SII order string ("ECS1008")
+//          or, without one, its SII device name; when several
 //          slaves share a name, each is "<name>_<position>"; "<position>" always works too
 //   entry  the entry's name (PDO entry name from the SII or dictionary); when a slave has two
 //          entries of that name, "<pdo name>.<entry name>"; "0xIIII:SS" always works too

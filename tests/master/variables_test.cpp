@@ -153,11 +153,12 @@ TEST_F(DemoVariablesTest, ConfiguredNamesGiveDi1Input3AndDrive1Statusword) {
 
 TEST_F(DemoVariablesTest, WithoutConfigurationTheSiiNamesAreMadeUnique) {
   ASSERT_TRUE(master_->start().ok());
-  // Two drives with the same SII name: "<name>_<position>".
-  const std::string drive1 = master_->slaves()[kDrive].name + "_4.Statusword";
-  const std::string drive2 = master_->slaves()[kDrive2].name + "_5.Statusword";
-  EXPECT_TRUE(master_->variable(drive1).ok()) << names();
-  EXPECT_TRUE(master_->variable(drive2).ok()) << names();
+  // The SII order strings of examples/esi/ecsim_devices.xml (<Type>); the two drives share
+  // theirs, so each gets "_<position>".
+  EXPECT_TRUE(master_->variable("ECS1008.Input 3").ok()) << names();
+  EXPECT_TRUE(master_->variable("ECS7201_4.Statusword").ok()) << names();
+  EXPECT_TRUE(master_->variable("ECS7201_5.Statusword").ok()) << names();
+  EXPECT_FALSE(master_->variable("ECS7201.Statusword").ok()) << names();
   EXPECT_TRUE(master_->variable("1.Input 3").ok()) << names();
   EXPECT_EQ(master::Master(net_.masterLink(), net_.bus()).variable("x").error().code,
             ErrorCode::kState);

@@ -1,8 +1,16 @@
-// ecmaster cyclic: bring the bus to OP, exchange process data at a fixed cycle, print
-// statistics (round trip min/mean/max, lost frames, WKC errors).
+// ecmaster cyclic: bring the bus to OP, exchange process data at a fixed cycle with health and
+// recovery (Master::cycle), print a live line every second (stderr with --json), then a
+// summary: round trip and cycle jitter (min, mean, max, p99, p99.9), lost, late and WKC
+// errors, slave events. --show NAME prints process variables; --rt runs the master on the
+// real-time driver's threads (master/rt_driver.hpp).
 #include <fmt/core.h>
 
+#include <chrono>
+#include <cstdio>
+#include <thread>
+
 #include "link/signal_flag.hpp"
+#include "master/rt_driver.hpp"
 #include "tools/ecmaster/commands.hpp"
 
 namespace ecsim::tools::ecmaster {
@@ -12,78 +20,203 @@ struct CyclicOptions {
   unsigned cycleUs{1000};
   double seconds{1.0};
   bool stopAtEnd{true};
+  bool rt{false};
+  bool quiet{false};
+  std::vector<std::string> show;
 };
+
+double us(SimTime ns) {
+  return static_cast<double>(ns) / 1e3;
+}
+
+nlohmann::json histogramJson(const master::LatencyHistogram& h) {
+  return {{"min", us(h.min())}, {"mean", us(h.mean())}, {"max", us(h.max())},
+          {"p99", us(h.p99())}, {"p999", us(h.p999())}, {"samples", h.count()}};
+}
+
+std::string histogramText(const master::LatencyHistogram& h) {
+  return fmt::format("min {:.1f} mean {:.1f} p99 {:.1f} p99.9 {:.1f} max {:.1f}", us(h.min()),
+                     us(h.mean()), us(h.p99()), us(h.p999()), us(h.max()));
+}
+
+std::string variablesText(const std::vector<master::PdoVariable>& vars) {
+  std::string s;
+  for (const auto& v : vars) s += fmt::format("  {} = {}", v.name(), v.format());
+  return s;
+}
+
+// Everything the summary needs, from the master (plain run) or the driver's snapshot.
+struct RunResult {
+  std::uint64_t cycles{0};
+  std::uint64_t failedCycles{0};
+  std::uint64_t overruns{0};
+  std::string firstError;
+  master::CyclicStatistics statistics;
+  master::MasterHealth health;
+  std::vector<master::MasterEvent> events;
+  std::optional<master::LatencyHistogram> wakeLatency;  // --rt
+};
+
+void printLive(const GlobalOptions& g, double second, const master::CyclicStatistics& st,
+               const master::MasterHealth& h, const std::vector<master::PdoVariable>& vars) {
+  std::FILE* out = g.json ? stderr : stdout;
+  fmt::print(out,
+             "[{:6.1f} s] cycles {} rtt us {} | jitter p99 {:.1f} us | lost {} late {} wkc {}{}\n",
+             second, st.cycles, histogramText(st.roundTrip), us(st.jitter.p99()), h.framesLost,
+             h.framesLate, h.wkcErrors, variablesText(vars));
+  std::fflush(out);
+}
 
 int runCyclic(const GlobalOptions& g, const CyclicOptions& o) {
   auto c = connectAndScan(g, true);
   if (!c.ok()) return fail(c.error());
   master::Master& m = (*c)->master();
   master::Bus& bus = (*c)->bus();
+  if (o.rt && (*c)->simulated())
+    return fail("--rt needs --iface (the simulator runs on virtual time)");
   if (auto s = m.bringTo(AlState::kOp); !s.ok()) return fail(s.error());
+  std::vector<master::PdoVariable> vars;
+  for (const auto& name : o.show) {
+    auto v = m.variable(name);
+    if (!v.ok()) return fail(v.error());
+    vars.push_back(std::move(v).value());
+  }
   const SimTime cycle = static_cast<SimTime>(o.cycleUs) * kNsPerUs;
   const SimTime duration = static_cast<SimTime>(o.seconds * static_cast<double>(kNsPerSecond));
-  SignalFlag stop;
+  m.setCycleTime(cycle);
+  m.resetStatistics();
+  m.clearEvents();
   const auto startCounters = m.transport().counters();
-  const std::uint64_t startCycles = m.statistics().cycles;
-  std::uint64_t failedCycles = 0;
-  std::uint64_t overruns = 0;
-  std::string firstError;
-  const SimTime start = bus.now();
-  SimTime next = start;
-  while (!stop.raised() && bus.now() - start < duration) {
-    auto status = m.exchange();
-    if (!status.ok()) {
-      ++failedCycles;
-      if (firstError.empty()) firstError = status.error().message();
+  SignalFlag stop;
+  RunResult r;
+  std::size_t eventsPrinted = 0;
+  auto printEvents = [&](const std::vector<master::MasterEvent>& events) {
+    for (; eventsPrinted < events.size(); ++eventsPrinted) {
+      fmt::print(g.json ? stderr : stdout, "event: {}\n", events[eventsPrinted].text);
     }
-    next += cycle;
-    if (bus.now() > next) {
-      ++overruns;  // the cycle took longer than its period: start the next one now
-      next = bus.now();
+  };
+  std::vector<std::string> warnings;
+  bool realtime = false;
+  if (o.rt) {
+    master::RtDriverOptions rto;
+    rto.period = cycle;
+    master::RtDriver driver(m, rto);
+    if (auto s = driver.start(); !s.ok()) return fail(s.error());
+    warnings = driver.warnings();
+    realtime = driver.realtime();
+    for (const auto& w : warnings) fmt::print(stderr, "ecmaster: warning: {}\n", w);
+    RealClock clock;
+    const SimTime start = clock.now();
+    SimTime nextPrint = start + kNsPerSecond;
+    while (!stop.raised() && clock.now() - start < duration) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      if (clock.now() >= nextPrint && !o.quiet) {
+        nextPrint += kNsPerSecond;
+        const auto snap = driver.snapshot();
+        printEvents(snap.events);
+        printLive(g, static_cast<double>(clock.now() - start) / 1e9, snap.statistics, snap.health,
+                  vars);
+      }
     }
-    while (bus.now() < next && !stop.raised()) bus.wait(next);
+    driver.stop();
+    const auto snap = driver.snapshot();
+    r.cycles = snap.cycles;
+    r.failedCycles = snap.failedCycles;
+    r.overruns = snap.overruns;
+    r.firstError = snap.firstError;
+    r.statistics = snap.statistics;
+    r.health = snap.health;
+    r.events = snap.events;
+    r.wakeLatency = snap.wakeLatency;
+  } else {
+    const SimTime start = bus.now();
+    SimTime next = start;
+    SimTime nextPrint = start + kNsPerSecond;
+    while (!stop.raised() && bus.now() - start < duration) {
+      auto status = m.cycle();
+      ++r.cycles;
+      if (!status.ok()) {
+        ++r.failedCycles;
+        if (r.firstError.empty()) r.firstError = status.error().message();
+      }
+      printEvents(m.events());
+      next += cycle;
+      if (bus.now() > next) {
+        ++r.overruns;  // the cycle took longer than its period: start the next one now
+        next = bus.now();
+      }
+      if (bus.now() >= nextPrint && !o.quiet) {
+        nextPrint += kNsPerSecond;
+        printLive(g, static_cast<double>(bus.now() - start) / 1e9, m.statistics(), m.health(),
+                  vars);
+      }
+      while (bus.now() < next && !stop.raised()) bus.wait(next);
+    }
+    r.statistics = m.statistics();
+    r.health = m.health();
+    r.events = m.events();
   }
-  const auto& st = m.statistics();
+  printEvents(r.events);
+  const auto& st = r.statistics;
   const auto& tc = m.transport().counters();
-  const std::uint64_t cycles = st.cycles - startCycles;
+  const std::uint64_t lost = tc.framesLost - startCounters.framesLost;
+  const std::uint64_t late = st.framesLate + (tc.framesLate - startCounters.framesLate);
   (void)m.readStates();
   Status stopped = o.stopAtEnd ? m.stop() : okStatus();
   if (g.json) {
-    nlohmann::json j{{"cycles", cycles},
+    nlohmann::json j{{"cycles", r.cycles},
                      {"cycleTimeUs", o.cycleUs},
-                     {"roundTripUs",
-                      {{"min", static_cast<double>(st.roundTripMin) / 1e3},
-                       {"mean", static_cast<double>(st.roundTripMean()) / 1e3},
-                       {"max", static_cast<double>(st.roundTripMax) / 1e3}}},
+                     {"roundTripUs", histogramJson(st.roundTrip)},
+                     {"jitterUs", histogramJson(st.jitter)},
                      {"framesPerCycle", m.layout().frameCount},
-                     {"framesLost", tc.framesLost - startCounters.framesLost},
-                     {"framesLate", tc.framesLate - startCounters.framesLate},
+                     {"framesLost", lost},
+                     {"framesLate", late},
                      {"wkcErrors", st.wkcErrors},
-                     {"failedCycles", failedCycles},
-                     {"overruns", overruns},
+                     {"failedCycles", r.failedCycles},
+                     {"overruns", r.overruns},
                      {"outputBytes", m.layout().outputBytes},
                      {"inputBytes", m.layout().inputBytes},
                      {"slaves", m.slaves().size()},
+                     {"slavesLost", r.health.slavesLost},
+                     {"slavesRecovered", r.health.slavesRecovered},
                      {"simulated", (*c)->simulated()}};
-    if (!firstError.empty()) j["firstError"] = firstError;
+    if (o.rt) {
+      j["realtime"] = realtime;
+      j["warnings"] = warnings;
+      if (r.wakeLatency) j["wakeLatencyUs"] = histogramJson(*r.wakeLatency);
+    }
+    nlohmann::json events = nlohmann::json::array();
+    for (const auto& e : r.events) {
+      events.push_back({{"cycle", e.cycle},
+                        {"position", e.position},
+                        {"kind", std::string(master::toString(e.kind))},
+                        {"text", e.text}});
+    }
+    j["events"] = events;
+    nlohmann::json shown = nlohmann::json::object();
+    for (const auto& v : vars) shown[v.name()] = v.format();
+    if (!vars.empty()) j["variables"] = shown;
+    if (!r.firstError.empty()) j["firstError"] = r.firstError;
     printJson(j);
   } else {
     fmt::print("{} slaves in OP, {} output + {} input bytes in {} frame(s) per cycle\n",
                m.slaves().size(), m.layout().outputBytes, m.layout().inputBytes,
                m.layout().frameCount);
-    fmt::print("cycles {} at {} us{}\n", cycles, o.cycleUs,
-               (*c)->simulated() ? " (virtual time)" : "");
-    fmt::print("round trip us: min {:.1f} mean {:.1f} max {:.1f}\n",
-               static_cast<double>(st.roundTripMin) / 1e3,
-               static_cast<double>(st.roundTripMean()) / 1e3,
-               static_cast<double>(st.roundTripMax) / 1e3);
+    fmt::print("cycles {} at {} us{}\n", r.cycles, o.cycleUs,
+               (*c)->simulated() ? " (virtual time)"
+               : o.rt            ? (realtime ? " (real-time threads)" : " (threads, not real-time)")
+                                 : "");
+    fmt::print("round trip us: {}\n", histogramText(st.roundTrip));
+    fmt::print("cycle jitter us: {}\n", histogramText(st.jitter));
+    if (r.wakeLatency) fmt::print("wake-up latency us: {}\n", histogramText(*r.wakeLatency));
     fmt::print("lost frames {}, late frames {}, WKC errors {}, failed cycles {}, overruns {}\n",
-               tc.framesLost - startCounters.framesLost, tc.framesLate - startCounters.framesLate,
-               st.wkcErrors, failedCycles, overruns);
-    if (!firstError.empty()) fmt::print("first error: {}\n", firstError);
+               lost, late, st.wkcErrors, r.failedCycles, r.overruns);
+    fmt::print("slaves lost {}, recovered {}\n", r.health.slavesLost, r.health.slavesRecovered);
+    if (!vars.empty()) fmt::print("variables:{}\n", variablesText(vars));
+    if (!r.firstError.empty()) fmt::print("first error: {}\n", r.firstError);
   }
   if (!stopped.ok()) return fail(stopped.error());
-  return failedCycles == 0 ? 0 : 1;
+  return r.failedCycles == 0 ? 0 : 1;
 }
 
 }  // namespace
@@ -96,6 +229,12 @@ CommandRunner addCyclicCommand(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--seconds", o->seconds, "How long to run (default 1)")
       ->check(CLI::Range(0.0, 86400.0));
   cmd->add_flag("!--no-stop", o->stopAtEnd, "Leave the slaves in OP at the end");
+  cmd->add_option("--show", o->show,
+                  "Print a process variable live and at the end (e.g. Drive1.Statusword); "
+                  "repeatable");
+  cmd->add_flag("--rt", o->rt,
+                "Run on real-time threads (SCHED_FIFO, mlockall; a warning when not permitted)");
+  cmd->add_flag("--quiet", o->quiet, "No live line every second");
   return [&global, o] { return runCyclic(global, *o); };
 }
 
