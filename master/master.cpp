@@ -120,6 +120,8 @@ Status Master::scan() {
   processData_.clear();
   layout_ = {};
   image_.clear();
+  dc_ = {};
+  cyclic_.setDcReference(std::nullopt);
   health_.reset();
   variables_.clear();
   (void)cyclic_.build(layout_, options_.transport.source);
@@ -265,6 +267,7 @@ Status Master::start() {
   if (config_) ECSIM_TRY(checkIdentities(*config_, slaves_));
   if (slaves_.empty()) return makeError(ErrorCode::kNotFound, "no slaves found");
   ECSIM_TRY(applyEniSetup());
+  if (options_.dc.enable) ECSIM_TRY(initDc());
   return bringTo(AlState::kOp);
 }
 

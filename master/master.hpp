@@ -28,6 +28,7 @@
 #include "master/bus.hpp"
 #include "master/coe_client.hpp"
 #include "master/cyclic.hpp"
+#include "master/dc.hpp"
 #include "master/eni_config.hpp"
 #include "master/health.hpp"
 #include "master/pdo_config.hpp"
@@ -51,6 +52,9 @@ struct MasterOptions {
   SimTime cycleTime{kNsPerMs};
   SimTime scanTimeout{30 * kNsPerSecond};
   SimTime mailboxTimeout{10 * kNsPerSecond};  // one SDO transfer or PDO discovery
+  // Distributed clocks (master/dc.hpp): with dc.enable, start() sets them up after the scan
+  // and the cyclic frame carries the reference clock's time.
+  DcOptions dc;
   // Cyclic health (master/health.hpp) in cycle(): with recovery a slave that disappears is
   // reported, the others keep running, and it is brought back to OP when it returns; without,
   // nothing is read or reconfigured and every missing working counter is a WKC error.
@@ -101,6 +105,15 @@ class Master {
   // master/variables.hpp lists), bound to the process image: get<std::int32_t>(), set(...).
   Result<PdoVariable> variable(std::string_view name);
   const std::vector<VariableInfo>& variables() const { return variables_; }
+
+  // ---- distributed clocks (master/dc.hpp) --------------------------------------------------
+  // Delays, offsets, static drift compensation, SYNC0 for the slaves whose ENI entry has <DC>
+  // or whose SII lists a DC op mode with SYNC0; the cyclic frame then carries an FRMW of the
+  // reference clock. Needs a scan.
+  Status initDc();
+  const DcSetup& dcSetup() const { return dc_; }
+  // Largest |0x092C| (ns) over the DC slaves other than the reference, read now.
+  Result<SimTime> dcSyncError();
 
   // ---- steps and services (tools, tests) ----------------------------------------------------
   Status scan();
@@ -167,6 +180,7 @@ class Master {
   std::unique_ptr<HealthMonitor> health_;  // made with the process image
   std::vector<VariableInfo> variables_;
   std::vector<MasterEvent> noEvents_;
+  DcSetup dc_;
   std::optional<AlState> initCmdsDoneFor_;  // the before-phase already ran for this target
   std::vector<char> transitionFrom_;        // per slave: the state letter it left
 };

@@ -1,0 +1,107 @@
+// Distributed clocks set-up by the master, as a step-driven task (ESC datasheet section I §9.1,
+// /work/shared/notes/ethercat-facts.md §C.4; the order SOEM uses, notes/soem-interop.md §3.3):
+//
+//   1. BWR 0x0900: every ESC latches the local time at which the frame reached each port
+//      (0x0900-0x090F) and its processing unit (0x0918);
+//   2. FPRD the latches of every DC slave;
+//   3. propagation delays from the port receive times (computeDcDelays: lines and trees,
+//      ports visited in the order 0-3-1-2 as docs/timing.md describes), relative to the
+//      reference clock (the first DC slave); FPWR 0x0928 delay and 0x0920 offset (master time
+//      at the latch minus the slave's 0x0918), BWR 0x0930 resets the drift filters;
+//   4. static drift compensation: `staticDriftFrames` FRMW of the reference's 0x0910, one per
+//      frame;
+//   5. SYNC0: for the slaves that ask for it, FPRD the reference's system time, then FPWR
+//      0x0981 = 0, 0x09A0 cycle time, 0x0990 start time (a whole number of cycles at least
+//      `sync0StartDelay` ahead, plus the shift) and 0x0980/0x0981 = AssignActivate (0x0300:
+//      cyclic unit + SYNC0).
+//
+// Afterwards the cyclic frame carries an FRMW of the reference's 0x0910 (CyclicExchange::
+// setDcReference) so the slaves' drift control loops keep running; readDcSyncError() reads
+// back every slave's 0x092C to report the achieved synchronisation.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "master/batch.hpp"
+#include "master/bus.hpp"
+#include "master/slave_info.hpp"
+#include "master/transport.hpp"
+
+namespace ecsim::master {
+
+struct DcOptions {
+  bool enable{false};  // Master::start() runs the DC set-up
+  std::size_t staticDriftFrames{15000};
+  bool activateSync0{true};
+  SimTime sync0Cycle{0};  // 0: MasterOptions::cycleTime
+  SimTime sync0Shift{0};
+  SimTime sync0StartDelay{100 * kNsPerMs};
+  // The master's time written as every slave's system time at the latch (ns since 2000);
+  // nullopt: the bus clock's time at the latch.
+  std::optional<std::uint64_t> masterTime;
+};
+
+// Port receive times 0x0900-0x090F of one slave (local clock, 32 bits each).
+using PortTimes = std::array<std::uint32_t, 4>;
+
+// Propagation delay of every slave from slave 0's port 0, from the receive times latched by one
+// frame: slave i hangs on port P of its parent (slaves[i].parent), children taking the parent's
+// open ports (activePorts) in the order 3, 1, 2 by position. For a child on port P,
+//   delay = delay(parent) + (t_parent[previous open port] - t_parent[0])
+//           + ((t_parent[P] - t_parent[previous open port]) - loop(child)) / 2
+// where loop(child) = t_child[its last open port] - t_child[0] (0 for an end slave): half the
+// time the frame spent below port P outside the child's own loop is the way down. Exact when an
+// ESC's processing and forwarding delays are equal (the model's defaults).
+std::vector<SimTime> computeDcDelays(const std::vector<SlaveInfo>& slaves,
+                                     const std::vector<PortTimes>& times);
+
+struct DcSetup {
+  std::optional<std::size_t> reference;  // position of the reference clock
+  std::vector<bool> dc;                  // per slave: has a DC unit (0x0008 bit 2)
+  std::vector<SimTime> delays;           // per slave, relative to the reference (0x0928)
+  std::vector<std::uint64_t> offsets;    // per slave (0x0920)
+  std::vector<std::size_t> sync0;        // positions SYNC0 was activated for
+  std::uint64_t sync0Start{0};           // 0x0990 written
+  SimTime sync0Cycle{0};
+};
+
+class DcInitTask final : public Task {
+ public:
+  // `assignActivate[i]`: the 0x0980 word for slave i (0: no SYNC0 for it).
+  DcInitTask(Transport& transport, std::vector<SlaveInfo>& slaves, DcOptions options,
+             SimTime cycleTime, std::vector<std::uint16_t> assignActivate);
+
+  void start(SimTime now);
+  bool step(SimTime now) override;
+  const Status& status() const { return status_; }
+  const DcSetup& result() const { return setup_; }
+
+ private:
+  enum class Phase { kLatch, kRead, kWrite, kDrift, kSync0Time, kSync0, kDone };
+  bool fail(Error error);
+  void queue();
+  void enter(Phase phase, SimTime now);
+
+  Transport& transport_;
+  std::vector<SlaveInfo>& slaves_;
+  DcOptions options_;
+  SimTime cycleTime_;
+  std::vector<std::uint16_t> assignActivate_;
+  DcSetup setup_;
+  Phase phase_{Phase::kDone};
+  DatagramBatch batch_;
+  std::size_t driftSent_{0};
+  std::uint64_t masterTime_{0};
+  Status status_;
+};
+
+// The largest |system time difference| (0x092C, sign-magnitude) over the DC slaves other than
+// the reference, as a batch to queue and a function to read it once answered.
+void addDcSyncErrorReads(DatagramBatch& batch, const std::vector<SlaveInfo>& slaves,
+                         const DcSetup& setup);
+Result<SimTime> dcSyncErrorFrom(const DatagramBatch& batch);
+
+}  // namespace ecsim::master
