@@ -2,6 +2,8 @@
 // the files they write (a capture tshark reads, a CSV with the documented columns, a PNG).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -35,6 +37,50 @@ TEST(EcsimTool, DemoBringsTheDemoNetworkToOpAndCycles) {
   EXPECT_NE(out->output.find("0 WKC errors, 0 lost frames"), std::string::npos) << out->output;
   EXPECT_NE(out->output.find("all slaves back in INIT"), std::string::npos) << out->output;
   EXPECT_TRUE(std::filesystem::exists(dir / "demo.pcap"));
+  EXPECT_NE(out->output.find("operation enabled after"), std::string::npos) << out->output;
+  // demo.csv: the documented columns, one row per cycle; the drive is enabled (statusword
+  // 0x..37), reaches the 5 turns of the move and comes back, with a following error that is
+  // there (the drive lags) but small (well under a tenth of a turn).
+  std::ifstream csv(dir / "demo.csv");
+  std::string line;
+  ASSERT_TRUE(std::getline(csv, line));
+  EXPECT_EQ(line, "time_s,commanded,actual,following_error,statusword,outputs");
+  int rows = 0;
+  long maxActual = 0;
+  long maxError = 0;
+  long lastActual = -1;
+  std::string lastStatus;
+  while (std::getline(csv, line)) {
+    ++rows;
+    std::istringstream fields(line);
+    std::string time, commanded, actual, error, status;
+    std::getline(fields, time, ',');
+    std::getline(fields, commanded, ',');
+    std::getline(fields, actual, ',');
+    std::getline(fields, error, ',');
+    std::getline(fields, status, ',');
+    maxActual = std::max(maxActual, std::stol(actual));
+    maxError = std::max(maxError, std::labs(std::stol(error)));
+    lastActual = std::stol(actual);
+    lastStatus = status;
+  }
+  EXPECT_EQ(rows, 3000);
+  EXPECT_NEAR(static_cast<double>(maxActual), 5 * 131072, 200) << "the move out reaches 5 turns";
+  EXPECT_NEAR(static_cast<double>(lastActual), 0, 50) << "and comes back";
+  EXPECT_GT(maxError, 100);
+  EXPECT_LT(maxError, 13107);
+  EXPECT_EQ(lastStatus.substr(lastStatus.size() - 2), "37") << lastStatus;
+  // demo.png: a PNG from gnuplot, with the script beside it.
+  EXPECT_TRUE(std::filesystem::exists(dir / "demo.gp"));
+  if (!std::filesystem::exists(dir / "demo.png")) {
+    if (ciMode()) FAIL() << "demo.png missing under CI=true (gnuplot-nox installed?)";
+    GTEST_SKIP() << "gnuplot not available: no demo.png";
+  }
+  std::ifstream png(dir / "demo.png", std::ios::binary);
+  char magic[4] = {};
+  png.read(magic, 4);
+  EXPECT_EQ(std::string(magic + 1, 3), "PNG");
+  EXPECT_GT(std::filesystem::file_size(dir / "demo.png"), 10000u);
 }
 
 // Golden capture (issue #6): a fast-mode run of the demo network (bring-up and 100 cycles)
@@ -54,6 +100,11 @@ TEST(EcsimTool, DemoCaptureIsDeterministicDecodesAndReplaysIdentically) {
       bb((std::istreambuf_iterator<char>(fb)), {});
   ASSERT_GT(ba.size(), 10000u);
   EXPECT_TRUE(ba == bb) << "two runs gave different captures";
+  std::ifstream ca(a / "demo.csv"), cb(b / "demo.csv");
+  std::string ta((std::istreambuf_iterator<char>(ca)), {}),
+      tb((std::istreambuf_iterator<char>(cb)), {});
+  EXPECT_GT(ta.size(), 1000u);
+  EXPECT_TRUE(ta == tb) << "two runs gave different demo.csv";
   auto tshark = runCommand(
       {"tshark", "-r", (a / "demo.pcap").string(), "-T", "fields", "-e", "frame.protocols"});
   if (!tshark.ok() || tshark->exitCode != 0) {
