@@ -150,10 +150,36 @@ TEST(SimulatedNetwork, OurMasterReachesOpAndTheTestSeesItsOutputs) {
   EXPECT_EQ(out->read<bool>(0x7000, 1).valueOr(false), true);
   EXPECT_EQ(out->read<bool>(0x7000, 2).valueOr(true), false);
   EXPECT_EQ(out->read<bool>(0x7000, 3).valueOr(false), true);
+  // The same outputs as the raw SM buffer the master wrote (DO1 has one output SM).
+  std::optional<std::vector<std::uint8_t>> buffer;
+  for (unsigned sm = 0; sm < 8 && !buffer; ++sm) {
+    if (auto b = out->outputBuffer(sm); b.ok()) buffer = *b;
+  }
+  ASSERT_TRUE(buffer.has_value());
+  ASSERT_EQ(buffer->size(), 1u);
+  EXPECT_EQ((*buffer)[0], 0x05);
+  EXPECT_EQ(out->outputBuffer(7).error().code, ErrorCode::kNotFound);
+  const std::uint8_t junk = 0xFF;
+  EXPECT_EQ(out->writeInputBuffer(7, ConstBytes(&junk, 1)).error().code, ErrorCode::kState);
   std::uint8_t in = 0;
   ASSERT_TRUE(m.readData(*diByte, Bytes(&in, 1)).ok());
   EXPECT_EQ(in & 0x07, 0x07);  // 1 and 3 from demo.xml, 2 from the test
   EXPECT_TRUE(m.stop().ok());
+}
+
+TEST(SimulatedNetwork, RealTimeRunForTakesRealTimeAndServeStopsWhenAsked) {
+  NetworkOptions options;
+  options.time = TimeMode::kRealTime;
+  options.idleWait = kNsPerMs;
+  auto net = SimulatedNetwork::fromTopologyFile(kDemo, options);
+  ASSERT_TRUE(net.ok());
+  EXPECT_EQ((*net)->virtualClock(), nullptr);
+  const SimTime before = (*net)->now();
+  ASSERT_TRUE((*net)->runFor(20 * kNsPerMs).ok());
+  EXPECT_GE((*net)->now() - before, 20 * kNsPerMs);
+  int steps = 0;
+  ASSERT_TRUE((*net)->serve([&] { return ++steps > 3; }).ok());
+  EXPECT_EQ(steps, 4);
 }
 
 TEST(SimulatedNetwork, WrapsANetworkBuiltInCode) {
