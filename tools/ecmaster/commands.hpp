@@ -33,6 +33,7 @@ CommandRunner addUploadCommand(CLI::App& app, const GlobalOptions& global);
 CommandRunner addDownloadCommand(CLI::App& app, const GlobalOptions& global);
 CommandRunner addSdosCommand(CLI::App& app, const GlobalOptions& global);
 CommandRunner addCyclicCommand(CLI::App& app, const GlobalOptions& global);
+CommandRunner addXmlCommand(CLI::App& app, const GlobalOptions& global);
 
 // ---- shared by the commands --------------------------------------------------------------------
 

@@ -23,7 +23,8 @@ int main(int argc, char** argv) {
                  "Talk to an in-process simulated network built from this topology file");
   app.add_option("--sim-slaves", global.connect.simSlaves,
                  "Talk to an in-process simulated line of N generic slaves");
-  app.add_option("--config", global.config, "Expected slaves (EcsimMaster XML): identity check");
+  app.add_option("--config", global.config,
+                 "Expected slaves (ENI EtherCATConfig or EcsimMaster XML): identity check");
   app.add_option("--timeout-ms", global.timeoutMs, "Frame timeout in ms (default 2)")
       ->check(CLI::Range(1u, 10000u));
   app.add_flag("--json", global.json, "Machine-readable output");
@@ -32,7 +33,7 @@ int main(int argc, char** argv) {
       {"sii", addSiiCommand(app, global)},           {"reg", addRegCommand(app, global)},
       {"pdos", addPdosCommand(app, global)},         {"upload", addUploadCommand(app, global)},
       {"download", addDownloadCommand(app, global)}, {"sdos", addSdosCommand(app, global)},
-      {"cyclic", addCyclicCommand(app, global)},
+      {"cyclic", addCyclicCommand(app, global)},     {"xml", addXmlCommand(app, global)},
   };
   CLI11_PARSE(app, argc, argv);
   try {
