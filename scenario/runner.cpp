@@ -9,6 +9,7 @@
 #include "config/topology_file.hpp"
 #include "link/memory_link.hpp"
 #include "link/pcap.hpp"
+#include "master/batch.hpp"
 #include "master/bus.hpp"
 #include "master/master.hpp"
 #include "master/process_image.hpp"
@@ -20,6 +21,8 @@
 
 namespace ecsim::scenario {
 namespace {
+
+constexpr std::uint64_t kStatusInterval = 100;  // cycles between routine AL status reads
 
 std::string ms(SimTime t) {
   return fmt::format("{:.3f} ms", static_cast<double>(t) / static_cast<double>(kNsPerMs));
@@ -58,9 +61,10 @@ class Run {
  private:
   SimTime sinceOp() const { return clock_.now() - t0_; }
   std::string slaveNameAtPosition(std::size_t position) const;
+  void learnStations();
   void observe(std::uint64_t cycle, const std::string& condition, std::set<std::string> slaves,
                const std::string& text);
-  void diagnoseAndRecover(std::uint64_t cycle);
+  void diagnoseAndRecover(std::uint64_t cycle, bool broken);
   bool allOp() const;
   void checkTimed(std::uint64_t cycle, bool atEnd);
   ExpectationResult evaluatePoint(const Expectation& x);
@@ -83,17 +87,24 @@ class Run {
   SimTime nextRecovery_{0};
   std::size_t emergenciesSeen_{0};
   std::map<std::string, std::pair<std::uint64_t, std::string>> lastLogged_;
+  std::map<std::uint16_t, std::string> stationNames_;
   const topology::FaultInjector* faults_{nullptr};
 };
 
 std::string Run::slaveNameAtPosition(std::size_t position) const {
   if (position >= master_->slaves().size()) return fmt::format("position {}", position);
-  const std::uint16_t station = master_->slaves()[position].station;
+  auto it = stationNames_.find(master_->slaves()[position].station);
+  return it == stationNames_.end() ? fmt::format("position {}", position) : it->second;
+}
+
+// Which simulated slave got which station address (taken after each successful start, as a
+// power cycle clears the address in the ESC).
+void Run::learnStations() {
   auto& seg = *network_.segment;
   for (std::size_t i = 0; i < seg.size(); ++i) {
-    if (seg.slave(i).esc().reg16(0x0010) == station) return seg.slave(i).name();
+    const std::uint16_t station = seg.slave(i).esc().reg16(0x0010);
+    if (station != 0) stationNames_[station] = seg.slave(i).name();
   }
-  return fmt::format("position {}", position);
 }
 
 void Run::observe(std::uint64_t cycle, const std::string& condition, std::set<std::string> slaves,
@@ -117,7 +128,7 @@ bool Run::allOp() const {
 
 // The application's part until the master recovers by itself: read every slave's state (this
 // is how lost slaves and state changes are reported) and restart the bus when needed.
-void Run::diagnoseAndRecover(std::uint64_t cycle) {
+void Run::diagnoseAndRecover(std::uint64_t cycle, bool broken) {
   if (clock_.now() < nextRecovery_) return;
   nextRecovery_ = clock_.now() + o_.recoveryInterval;
   auto states = master_->readStates();
@@ -132,16 +143,37 @@ void Run::diagnoseAndRecover(std::uint64_t cycle) {
     }
     observe(cycle, "slave-lost", names, "slave(s) not answering: " + states.error().context);
   }
+  // A frame lost now and then needs no restart; a slave missing, out of OP or a working
+  // counter that differs (a slave more or less on the bus) does.
+  bool restart =
+      broken || !states.ok() || master_->lastCycle().wkcErrors > 0 || master_->slaves().empty();
   for (std::size_t p = 0; p < master_->slaves().size(); ++p) {
     const auto& info = master_->slaves()[p];
     if (info.state() && *info.state() != AlState::kOp) {
+      restart = true;
       observe(
           cycle, "slave-state", {slaveNameAtPosition(p)},
           fmt::format("slave {} '{}' in {}", p, slaveNameAtPosition(p), toString(*info.state())));
     }
   }
+  if (!restart && states.ok()) {
+    // A slave that came back (power on, cable plugged in) has no station address yet and
+    // adds nothing to the cyclic working counters: count the slaves with a broadcast read.
+    master::DatagramBatch batch;
+    batch.add().prepare(Command::kBrd, DatagramHeader::physical(0, 0x0130), 2,
+                        static_cast<std::uint16_t>(master_->slaves().size()));
+    batch.queueAll(master_->transport());
+    master::BatchWait wait(batch);
+    (void)master::runTask(wait, master_->transport(), master_->bus(), 10 * kNsPerMs, "slave count");
+    if (auto c = batch.check(); !c.ok()) {
+      observe(cycle, "slave-count", {}, "slave count changed: " + c.error().context);
+      restart = true;
+    }
+  }
+  if (!restart) return;
   ++recoveries_;
   auto started = master_->start();
+  if (started.ok()) learnStations();
   r_.log.push_back(fmt::format(
       "{:>12}  cycle {:>6}  recovery: restart {}", ms(sinceOp()), cycle,
       started.ok() ? std::string("ok, all slaves in OP") : "failed: " + started.error().context));
@@ -226,6 +258,7 @@ ExpectationResult Run::evaluatePoint(const Expectation& x) {
         const std::uint32_t bit = var->bitOffset + b;
         if (bit / 8 < image.size() && ((image[bit / 8] >> (bit % 8)) & 1) != 0) raw |= 1ull << b;
       }
+      raw &= x.mask;
       double v = static_cast<double>(raw);
       if (x.isSigned && var->bitLength < 64 && ((raw >> (var->bitLength - 1)) & 1) != 0) {
         v = static_cast<double>(static_cast<std::int64_t>(raw) -
@@ -376,12 +409,17 @@ ScenarioResult Run::execute() {
   master::MasterOptions mo;
   mo.cycleTime = s_.cycleTime;
   master_ = std::make_unique<master::Master>(masterEnd, bus, mo);
+  struct ResetFirst {  // the master goes before the link and bus it uses, on every return
+    std::unique_ptr<master::Master>& master;
+    ~ResetFirst() { master.reset(); }
+  } resetFirst{master_};
   if (auto st = master_->start(); !st.ok()) {
     r_.error = "the master did not reach OP: " + st.error().message();
     segment.setCableObserver(0, 0, nullptr);
     return r_;
   }
   t0_ = clock_.now();
+  learnStations();
   checked_.assign(s_.expectations.size(), false);
   std::vector<bool> applied(s_.actions.size(), false);
   const std::uint64_t total = static_cast<std::uint64_t>(s_.duration / s_.cycleTime);
@@ -428,6 +466,8 @@ ScenarioResult Run::execute() {
                                      a.action.text(), what));
       }
     }
+    // "At cycle N": after cycle N's actions, before its exchange.
+    checkTimed(cycle, false);
     bool good = false;
     if (clock_.now() < pausedUntil) {
       segment.pollSlaves(clock_.now());
@@ -443,11 +483,18 @@ ScenarioResult Run::execute() {
         for (auto p : last.firstMismatch->slaves) names.insert(slaveNameAtPosition(p));
         observe(cycle, "wkc-error", names, last.firstMismatch->describe(master_->slaves()));
       }
+      if (!st.ok() && last.framesLost == 0 && last.wkcErrors == 0) {
+        observe(cycle, st.error().code == ErrorCode::kTimeout ? "frame-lost" : "cycle-error", {},
+                st.error().message());
+      }
       if (master_->emergencies().size() > emergenciesSeen_) {
         emergenciesSeen_ = master_->emergencies().size();
         observe(cycle, "emergency", {}, "emergency received");
       }
-      if (o_.recovery && !good) diagnoseAndRecover(cycle);
+      // After an error at once, otherwise every 100 cycles: the AL status of every slave.
+      if (o_.recovery && (!good || cycle % kStatusInterval == 0)) {
+        diagnoseAndRecover(cycle, !st.ok() && last.framesLost == 0);
+      }
     }
     if (good) {
       run_ = 0;
@@ -456,7 +503,6 @@ ScenarioResult Run::execute() {
       longestRun_ = std::max(longestRun_, ++run_);
     }
     cleanCycles_.push_back({cycle, good && allOp()});
-    checkTimed(cycle, false);
     ++cycle;
     next += s_.cycleTime;
   }

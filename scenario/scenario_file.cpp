@@ -197,6 +197,8 @@ Result<Expectation> readExpectation(const Reader& r, const XMLElement* e) {
     }
     x.index = static_cast<std::uint16_t>(*index);
     x.subindex = static_cast<std::uint8_t>(*sub);
+    ECSIM_ASSIGN_OR_RETURN(auto mask, r.number(e, "mask"));
+    x.mask = static_cast<std::uint32_t>(mask.value_or(0xFFFFFFFF));
     ECSIM_ASSIGN_OR_RETURN(auto isSigned, r.boolean(e, "signed"));
     x.isSigned = isSigned.value_or(false);
   } else {
