@@ -61,6 +61,41 @@ std::uint16_t AlStateMachine::checkProcessData(const Esc& esc, const SlaveProfil
   return 0;
 }
 
+std::uint16_t AlStateMachine::checkSyncConfiguration(const Esc& esc,
+                                                     const SlaveProfile& profile) const {
+  // What slave stacks check at PREOP->SAFEOP (ETG.1020 §6.4 and the AL status codes of
+  // ETG.1000.6 Table 11): SYNC pulses need a device that can use them; a DC sync mode the
+  // master selected in 0x1C32:01 needs the matching SYNC signal activated; a SYNC0 cycle below
+  // the device's minimum cycle time (0x1C32:05) is refused.
+  // Without firmware (device emulation) nothing checks the cyclic unit's configuration.
+  if (esc.deviceEmulation()) return 0;
+  const SlaveProfile::Sync& sync = profile.sync;
+  const bool sync0 = esc.syncActive(0);
+  const bool sync1 = esc.syncActive(1);
+  if ((sync0 || sync1) && !sync.dcSupported) {
+    return code(AlStatusCode::kInvalidDcSyncConfiguration);
+  }
+  const bool modeChosen = sync.mode != SlaveProfile::kNoSyncObject && sync.mode != sync.initialMode;
+  if (modeChosen && ((sync.mode == 2 && !sync0) || (sync.mode == 3 && !sync1))) {
+    return code(AlStatusCode::kInvalidDcSyncConfiguration);
+  }
+  if (sync0 && sync.minCycleNs != 0) {
+    const std::uint32_t cycle = esc.reg32(reg::kSync0CycleTime.address);
+    if (cycle != 0 && cycle < sync.minCycleNs) {
+      return code(AlStatusCode::kDcInvalidSync0CycleTime);
+    }
+  }
+  return 0;
+}
+
+void AlStateMachine::checkSynchronisation(Esc& esc) {
+  if (!dcSynchronous_ || state(esc) != AlState::kOp) return;
+  if (!esc.syncActive(0)) {
+    dcSynchronous_ = false;
+    raiseError(esc, AlState::kSafeOp, code(AlStatusCode::kFatalSyncError));
+  }
+}
+
 void AlStateMachine::raiseError(Esc& esc, AlState target, std::uint16_t statusCode) {
   AlState current = state(esc);
   AlState next = rank(target) >= 0 && rank(target) < rank(current) ? target : current;
@@ -107,7 +142,11 @@ void AlStateMachine::onAlControl(Esc& esc, const SlaveProfile& profile) {
     if (errorCode == 0) next = AlState::kPreOp;
   } else if (*requested == AlState::kSafeOp) {
     errorCode = checkProcessData(esc, profile);
-    if (errorCode == 0) next = AlState::kSafeOp;
+    if (errorCode == 0) errorCode = checkSyncConfiguration(esc, profile);
+    if (errorCode == 0) {
+      next = AlState::kSafeOp;
+      dcSynchronous_ = esc.syncActive(0);
+    }
   } else {  // SAFEOP -> OP: the master must have delivered valid outputs first
     for (const auto& pd : profile.processData) {
       if (pd.outputs && pd.length > 0 && !esc.pdiOutputsReceived(pd.index)) {

@@ -28,6 +28,18 @@ struct SlaveProfile {
     std::uint16_t length{0};  // expected byte length for the active PDO assignment
   };
   std::vector<ProcessDataSm> processData;
+  // Synchronisation (ETG.1020 §6; 0x1C32 SM output parameter).
+  struct Sync {
+    bool dcSupported{false};  // the device has DC operation modes (ESI Dc, SII DC category)
+    // 0x1C32:01 sync mode now and as the device started; a value the master changed in PREOP
+    // is checked against the cyclic unit's activation (0 free run, 1 SM, 2 DC SYNC0,
+    // 3 DC SYNC1). kNoSyncObject: the device has no 0x1C32.
+    std::uint16_t mode{kNoSyncObject};
+    std::uint16_t initialMode{kNoSyncObject};
+    std::uint32_t minCycleNs{0};  // 0x1C32:05, 0 = not given
+  };
+  static constexpr std::uint16_t kNoSyncObject = 0xFFFF;
+  Sync sync;
 };
 
 class AlStateMachine {
@@ -40,6 +52,11 @@ class AlStateMachine {
   // the error flag and the code, as ETG.1000.6 Table 11 prescribes.
   void raiseError(Esc& esc, AlState state, std::uint16_t code);
 
+  // Called by the firmware's poll: in OP, a lost SYNC0 (cyclic unit deactivated while the
+  // slave runs DC-synchronous, as chosen at PREOP->SAFEOP) drops to SAFEOP with 0x002C.
+  void checkSynchronisation(Esc& esc);
+  bool dcSynchronous() const { return dcSynchronous_; }
+
   static AlState state(const Esc& esc) {
     return static_cast<AlState>(esc.alStatus() & reg::al::kStateMask);
   }
@@ -47,6 +64,9 @@ class AlStateMachine {
  private:
   std::uint16_t checkMailbox(const Esc& esc, const SlaveProfile::Mailbox& mbx) const;
   std::uint16_t checkProcessData(const Esc& esc, const SlaveProfile& profile) const;
+  std::uint16_t checkSyncConfiguration(const Esc& esc, const SlaveProfile& profile) const;
+
+  bool dcSynchronous_{false};
 };
 
 }  // namespace ecsim::slavesim

@@ -124,6 +124,8 @@ void Esc::reset() {
   std::fill(memory_.begin(), memory_.end(), 0);
   std::fill(buffers_.begin(), buffers_.end(), 0);
   sm_ = {};
+  pdWatchdog_ = {};
+  sync_ = {};
   activeFmmuCount_ = 0;
   smRangeCount_ = 0;
   lastMailboxResponseSize_ = 0;
@@ -374,6 +376,7 @@ void Esc::rebuildSmCache() {
     if (!c.enabled || c.length == 0) continue;
     smRanges_[smRangeCount_++] = {c.start, static_cast<std::uint32_t>(c.start) + c.length,
                                   static_cast<std::uint8_t>(s)};
+    smCache_[s] = c;
   }
 }
 
@@ -417,16 +420,19 @@ bool isEcatWrite(std::uint8_t control) {
 
 bool Esc::readRam(std::uint16_t address, Bytes out, bool orInto, int smIndex) {
   auto copyOut = [&](const std::uint8_t* src) {
-    for (std::size_t i = 0; i < out.size(); ++i) {
-      out[i] = orInto ? static_cast<std::uint8_t>(out[i] | src[i]) : src[i];
+    if (!orInto) {
+      std::copy_n(src, out.size(), out.begin());
+      return;
     }
+    for (std::size_t i = 0; i < out.size(); ++i)
+      out[i] = static_cast<std::uint8_t>(out[i] | src[i]);
   };
   if (smIndex < 0) {
     copyOut(&memory_[address]);
     return true;
   }
   const auto s = static_cast<unsigned>(smIndex);
-  const SmConfig cfg = smConfig(s);
+  const SmConfig& cfg = smCache_[s];  // smIndex comes from smLookup: the SM is cached
   SmState& st = sm_[s];
   const std::uint16_t base = reg::smChannel(s);
   const bool lastByte = address + out.size() == static_cast<std::size_t>(cfg.start) + cfg.length;
@@ -459,7 +465,7 @@ bool Esc::writeRam(std::uint16_t address, ConstBytes data, int smIndex) {
     return true;
   }
   const auto s = static_cast<unsigned>(smIndex);
-  const SmConfig cfg = smConfig(s);
+  const SmConfig& cfg = smCache_[s];  // smIndex comes from smLookup: the SM is cached
   SmState& st = sm_[s];
   const std::uint16_t base = reg::smChannel(s);
   const bool lastByte = address + data.size() == static_cast<std::size_t>(cfg.start) + cfg.length;
@@ -470,6 +476,7 @@ bool Esc::writeRam(std::uint16_t address, ConstBytes data, int smIndex) {
       return false;  // full: write refused, no WKC (the master retries)
     }
     std::copy(data.begin(), data.end(), memory_.begin() + address);
+    if ((cfg.control & reg::sm::kControlWatchdog) != 0) triggerPdWatchdog();
     if (lastByte) {
       st.mailboxFull = true;
       st.hasLatest = true;  // for 1-buffer process data: outputs received
@@ -480,6 +487,7 @@ bool Esc::writeRam(std::uint16_t address, ConstBytes data, int smIndex) {
     return true;
   }
   if (!isEcatWrite(cfg.control)) return false;  // inputs: master writes are ignored
+  if ((cfg.control & reg::sm::kControlWatchdog) != 0) triggerPdWatchdog();
   const std::size_t offset = static_cast<std::size_t>(address - cfg.start);
   const std::size_t bufBase = 3u * static_cast<std::size_t>(cfg.start);
   std::copy(
@@ -508,9 +516,53 @@ bool Esc::writeRam(std::uint16_t address, ConstBytes data, int smIndex) {
 
 namespace ecsim::slavesim {
 
+void Esc::systemTimeWritten(std::uint32_t begin, std::uint32_t end, ConstBytes data) {
+  // Written system time is compared with the local copy; the difference feeds the drift
+  // control loop (datasheet section I §9.1.3). A 32-bit write compares the low 32 bits.
+  // 0x092C: bit 31 set = local copy smaller than the received time.
+  const SimTime local = wrapAdd(localNow_, reg64(reg::kSystemTimeOffset.address));
+  std::uint64_t written = static_cast<std::uint64_t>(local);
+  if (begin == reg::kSystemTime.address && end == reg::kSystemTime.end()) {
+    written = readLe64(data, 0);  // the usual 64-bit distribution (ARMW/FRMW)
+  } else {
+    for (std::uint32_t i = 0; i < 8; ++i) {
+      std::uint32_t a = reg::kSystemTime.address + i;
+      if (a >= begin && a < end) {
+        written = (written & ~(0xFFull << (8 * i))) |
+                  (static_cast<std::uint64_t>(data[a - begin]) << (8 * i));
+      }
+    }
+  }
+  const SimTime received =
+      wrapAdd(static_cast<SimTime>(written), reg32(reg::kSystemTimeDelay.address));
+  const std::int64_t diff = dc_.onSystemTimeWrite(
+      now_, local, received, memory_[reg::kSystemTimeDifferenceFilterDepth.address] & 0x0F);
+  const std::uint32_t mag =
+      static_cast<std::uint32_t>(std::min<std::int64_t>(diff < 0 ? -diff : diff, 0x7FFFFFFF));
+  writeLe32(memory_, reg::kSystemTimeDifference.address, diff < 0 ? (mag | 0x80000000u) : mag);
+}
+
 bool Esc::writeRegisters(std::uint16_t address, ConstBytes data) {
   const std::uint32_t begin = address;
   const std::uint32_t end = address + static_cast<std::uint32_t>(data.size());
+  if (begin >= reg::kSystemTime.address && end <= reg::kSystemTime.end()) {
+    // Fast path for the cyclic DC distribution (ARMW/FRMW of 0x0910 reaches every ESC but the
+    // reference once per frame): no other register with side effects lies in this range.
+    bool accepted = false;
+    if (data.size() == 8) {  // all of it: one 64-bit masked merge
+      const std::uint64_t mask = readLe64(writable_, begin);
+      writeLe64(memory_, begin, (reg64(address) & ~mask) | (readLe64(data, 0) & mask));
+      accepted = mask != 0;
+    }
+    for (std::uint32_t i = 0; data.size() != 8 && i < data.size(); ++i) {
+      const std::uint32_t a = begin + i;
+      const std::uint8_t mask = writable_[a];
+      accepted |= mask != 0;
+      memory_[a] = static_cast<std::uint8_t>((memory_[a] & ~mask) | (data[i] & mask));
+    }
+    systemTimeWritten(begin, end, data);
+    return accepted;
+  }
   // SM channel registers 0x0800-0x0804 are writable only while the SM is disabled
   // (datasheet section II, SyncManager register description).
   std::array<bool, reg::kMaxSyncManagers> smWasEnabled{};
@@ -577,29 +629,12 @@ bool Esc::writeRegisters(std::uint16_t address, ConstBytes data) {
     siiCommand(reg16(reg::kSiiControlStatus.address));
   }
   if (overlaps(begin, end, reg::kSystemTime.address, reg::kSystemTime.width)) {
-    // Written system time is compared with the local copy; the difference feeds the drift
-    // control loop (datasheet section I §9.1.3). A 32-bit write compares the low 32 bits.
-    // 0x092C: bit 31 set = local copy smaller than the received time.
-    const SimTime local = wrapAdd(localNow_, reg64(reg::kSystemTimeOffset.address));
-    std::uint64_t written = static_cast<std::uint64_t>(local);
-    for (std::uint32_t i = 0; i < 8; ++i) {
-      std::uint32_t a = reg::kSystemTime.address + i;
-      if (a >= begin && a < end) {
-        written = (written & ~(0xFFull << (8 * i))) |
-                  (static_cast<std::uint64_t>(data[a - begin]) << (8 * i));
-      }
-    }
-    const SimTime received =
-        wrapAdd(static_cast<SimTime>(written), reg32(reg::kSystemTimeDelay.address));
-    const std::int64_t diff = dc_.onSystemTimeWrite(
-        now_, local, received, memory_[reg::kSystemTimeDifferenceFilterDepth.address] & 0x0F);
-    const std::uint32_t mag =
-        static_cast<std::uint32_t>(std::min<std::int64_t>(diff < 0 ? -diff : diff, 0x7FFFFFFF));
-    writeLe32(memory_, reg::kSystemTimeDifference.address, diff < 0 ? (mag | 0x80000000u) : mag);
+    systemTimeWritten(begin, end, data);
   }
   if (overlaps(begin, end, reg::kSpeedCounterStart.address, reg::kSpeedCounterStart.width)) {
     dc_.resetControl();
   }
+  if (overlaps(begin, end, reg::kDcActivation.address, 1)) onSyncActivationWrite();
   if (overlaps(begin, end, reg::kFmmuBase, reg::kFmmuSize * reg::kMaxFmmus)) rebuildFmmuCache();
   if (overlaps(begin, end, reg::kSmBase, reg::kSmSize * reg::kMaxSyncManagers)) {
     for (unsigned s = 0; s < type_.syncManagers; ++s) {
@@ -628,6 +663,7 @@ void Esc::smActivationChanged(unsigned s) {
 }
 
 void Esc::refreshVolatile(std::uint16_t begin, std::uint16_t end) {
+  if (overlaps(begin, end, reg::kCyclicUnitControl.address, 0x28)) refreshSyncRegisters(begin, end);
   if (overlaps(begin, end, reg::kSystemTime.address, reg::kSystemTime.width)) {
     writeLe64(
         memory_, reg::kSystemTime.address,

@@ -186,6 +186,26 @@ class Esc {
   // Power cycle: registers back to reset values, EEPROM content kept, reloaded.
   void powerOnReset();
 
+  // ---- time-driven units (esc_time_units.cpp) ---------------------------------------------
+  // Process-data watchdog (0x0400, 0x0420, 0x0440, 0x0442): every ECAT write to the buffer of
+  // an SM whose control byte has the watchdog trigger bit (0x40) re-arms it; it expires when
+  // no such write came for 0x0420 x (0x0400 + 2) x 40 ns (0x0420 = 0: disabled). Returns true
+  // once per expiry, when `now` is past it (status bit cleared, counter incremented then).
+  bool pdWatchdogExpired(SimTime now);
+  // ESC configuration 0x0141 bit 0: the ESC itself copies AL control to AL status (no
+  // firmware state machine, as in simple IO terminals without a microcontroller).
+  bool deviceEmulation() const { return (memory_[reg::kEscConfiguration.address] & 0x01) != 0; }
+  // SYNC0/SYNC1 pulses of the cyclic unit that are due at or before `now`, one per call, in
+  // time order; false when none is due. `time` is the simulation time of the pulse.
+  struct SyncPulse {
+    unsigned signal{0};
+    SimTime time{0};
+  };
+  bool nextSyncPulse(SimTime now, SyncPulse& pulse);
+  // The cyclic unit was activated with a start time already in the past: as on the ET1100,
+  // the first pulse waits for the 64-bit system time to reach it again (never, in practice).
+  bool syncStartMissed() const { return sync_.running && sync_.startMissed; }
+
   const EscCounters& counters() const { return counters_; }
 
  private:
@@ -211,6 +231,9 @@ class Esc {
   bool writeRam(std::uint16_t address, ConstBytes data, int sm);
   // Returns false when no byte of the range is writable for ECAT (no WKC then).
   bool writeRegisters(std::uint16_t address, ConstBytes data);
+  // [begin, end) overlapping 0x0910-0x0917 was written with `data` (starting at begin): one
+  // step of the drift control loop, 0x092C updated.
+  void systemTimeWritten(std::uint32_t begin, std::uint32_t end, ConstBytes data);
   void refreshVolatile(std::uint16_t begin, std::uint16_t end);
   void siiCommand(std::uint16_t control);
   void smActivationChanged(unsigned sm);
@@ -226,11 +249,52 @@ class Esc {
     } else if (address >= reg::kSmBase &&
                address < reg::kSmBase + reg::kSmSize * reg::kMaxSyncManagers) {
       rebuildSmCache();
+    } else if (address == reg::kCyclicUnitControl.address ||
+               address == reg::kDcActivation.address) {
+      onSyncActivationWrite();
     }
   }
   // Logical addressing through FMMUs. Returns {readHit, writeHit}.
   std::pair<bool, bool> processLogical(DatagramView d, bool doRead, bool doWrite);
   void latchReceiveTimes();
+  // Time-driven units (esc_time_units.cpp).
+  void triggerPdWatchdog() {
+    pdWatchdog_.armed = true;
+    pdWatchdog_.expired = false;
+    pdWatchdog_.lastTrigger = now_;
+    memory_[reg::kWatchdogStatusProcessData.address] |= 0x01;
+  }
+  void onSyncActivationWrite();
+  void refreshSyncRegisters(std::uint16_t begin, std::uint16_t end);
+  std::uint64_t systemTimeNow() const;
+  std::uint64_t lastSync0(std::uint64_t sysNow, bool& any) const;
+  std::uint64_t sync1Time(std::uint64_t k) const;
+  std::uint64_t sync1IndexAfter(std::uint64_t sysNow) const;
+
+  struct PdWatchdog {
+    bool armed{false};
+    bool expired{false};
+    SimTime lastTrigger{0};
+  };
+  PdWatchdog pdWatchdog_{};
+  // Cyclic unit state, latched at activation (system times).
+  struct SyncState {
+    bool running{false};
+    bool startMissed{false};
+    bool sync0{false};
+    bool sync1{false};
+    std::uint64_t start{0};
+    std::uint64_t cycle0{0};
+    std::uint64_t cycle1{0};
+    std::uint64_t pulseLength{0};  // ns; 0 = acknowledge mode
+    std::uint64_t next0Index{0};   // next SYNC0 pulse: start + index * cycle0
+    std::uint64_t next1Index{0};
+    bool done0{false};  // single shot delivered
+    bool done1{false};
+    std::uint64_t ack0{0};  // system time of the last status read (acknowledge mode)
+    std::uint64_t ack1{0};
+  };
+  SyncState sync_{};
 
   const EscType type_;
   std::vector<std::uint8_t> memory_;  // registers 0x0000-0x0FFF + process RAM
@@ -263,6 +327,8 @@ class Esc {
   };
   std::array<SmRange, reg::kMaxSyncManagers> smRanges_{};
   std::uint8_t smRangeCount_{0};
+  // smConfig() of the SMs in smRanges_, as of the last rebuildSmCache().
+  std::array<SmConfig, reg::kMaxSyncManagers> smCache_{};
   std::array<ActiveFmmu, reg::kMaxFmmus> activeFmmus_{};
   std::uint8_t activeFmmuCount_{0};
   std::vector<std::uint8_t> scratch_;  // read-write and bit-FMMU staging, one datagram

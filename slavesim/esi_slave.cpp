@@ -69,6 +69,8 @@ Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiDevice& device, std::st
   }
   pd->setVirtualSyncManagers(virtualSms);
   pd->updateProfile(profile);
+  profile.sync.initialMode = profile.sync.mode;
+  profile.sync.dcSupported = !device.dcOpModes.empty();
   if (options.deviceModels) {
     devices::DeviceModelOptions modelOptions = options.models;
     if (!options.stateFile.empty()) modelOptions.stateFile = options.stateFile;

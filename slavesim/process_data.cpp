@@ -129,6 +129,13 @@ ProcessDataDevice::ProcessDataDevice(std::shared_ptr<coe::ObjectDictionary> od)
 }
 
 void ProcessDataDevice::updateProfile(SlaveProfile& profile) {
+  // Sync mode and minimum cycle time as the dictionary holds them now (0x1C32:01, :05).
+  const coe::Entry* mode = od_->findEntry(coe::kSmOutputParameterIndex, 1);
+  profile.sync.mode = mode != nullptr && mode->value.size() >= 2 ? readLe16(mode->value, 0)
+                                                                 : SlaveProfile::kNoSyncObject;
+  const coe::Entry* minCycle = od_->findEntry(coe::kSmOutputParameterIndex, 5);
+  profile.sync.minCycleNs =
+      minCycle != nullptr && minCycle->value.size() >= 4 ? readLe32(minCycle->value, 0) : 0;
   bindStatus_ = binding_.bind(*od_, virtualSms_);
   if (bindStatus_.ok()) {
     binding_.fillProfile(profile, virtualSms_);

@@ -36,6 +36,21 @@ void Slave::poll(SimTime now) {
     if (req != ackBit) esc_.pdiMailboxRepeat();
   }
   if (mailbox_) mailbox_->poll(esc_, now);
+  // SYNC pulses due since the last poll go to the device in time order (bounded per poll so a
+  // very long gap cannot stall the simulator; the rest follow at the next poll).
+  Esc::SyncPulse pulse;
+  for (unsigned n = 0; n < kMaxSyncPulsesPerPoll && esc_.nextSyncPulse(now, pulse); ++n) {
+    ++syncPulses_;
+    if (device_) device_->sync(esc_, pulse.signal, state(), pulse.time);
+  }
+  // Process-data watchdog: a slave with firmware leaves OP for SAFEOP with 0x001B (ETG.1000.6
+  // Table 11); with device emulation the ESC only counts it (the firmware-less terminal keeps
+  // its state; its outputs go to their safe value).
+  if (esc_.pdWatchdogExpired(now) && state() == AlState::kOp && !esc_.deviceEmulation()) {
+    esm_.raiseError(esc_, AlState::kSafeOp,
+                    static_cast<std::uint16_t>(AlStatusCode::kSyncManagerWatchdog));
+  }
+  esm_.checkSynchronisation(esc_);
   if (device_) device_->step(esc_, state(), now);
   // 1-buffer process-data outputs: the device has taken them; free the buffer for the next.
   for (const auto& pd : profile_.processData) {

@@ -58,6 +58,9 @@ class Slave {
   void poll(SimTime now);
 
   AlStateMachine& stateMachine() { return esm_; }
+  // SYNC0/SYNC1 pulses delivered to the device so far.
+  std::uint64_t syncPulses() const { return syncPulses_; }
+  static constexpr unsigned kMaxSyncPulsesPerPoll = 4096;
 
   // Power. Off: the firmware stops (the topology breaks the links at the neighbours' ports).
   // On: a power-on reset of the ESC (registers and AL state; the EEPROM content is kept); the
@@ -77,6 +80,7 @@ class Slave {
   std::unique_ptr<MailboxServer> mailbox_;
   std::unique_ptr<Device> device_;
   std::vector<std::uint8_t> mailboxBuffer_;
+  std::uint64_t syncPulses_{0};
   bool powered_{true};
   bool firmwareRunning_{true};
 };
