@@ -1,0 +1,124 @@
+#include "topology/network_from_eni.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <map>
+
+#include "config/esi.hpp"
+
+namespace ecsim::topology {
+namespace {
+
+struct Candidate {
+  std::filesystem::path file;
+  std::uint32_t vendor{0};
+  std::uint32_t product{0};
+  std::uint32_t revision{0};
+};
+
+std::string hex8(std::uint32_t v) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "0x%08X", v);
+  return buf;
+}
+
+// Every device of every ESI file in the folders (files that are not ESI are skipped).
+std::vector<Candidate> catalogue(const std::vector<std::filesystem::path>& dirs) {
+  std::vector<Candidate> out;
+  for (const auto& dir : dirs) {
+    std::error_code ec;
+    std::vector<std::filesystem::path> files;
+    for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+      if (entry.is_regular_file() && entry.path().extension() == ".xml") {
+        files.push_back(entry.path());
+      }
+    }
+    std::sort(files.begin(), files.end());  // deterministic choice between equal devices
+    for (const auto& file : files) {
+      auto esi = loadEsiFile(file);
+      if (!esi.ok()) continue;
+      for (const auto& device : esi->devices) {
+        if (!device.hasProductCode) continue;
+        out.push_back({file, esi->vendor.id, device.productCode, device.revision});
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+Result<TopologyConfig> topologyFromEni(const EniConfig& eni,
+                                       const std::vector<std::filesystem::path>& esiDirs) {
+  const std::vector<Candidate> devices = catalogue(esiDirs);
+  TopologyConfig config;
+  config.file = eni.file;
+  config.name = eni.file.stem().string();
+  std::map<std::uint16_t, std::size_t> byAddress;
+  for (std::size_t i = 0; i < eni.slaves.size(); ++i) {
+    const EniSlave& s = eni.slaves[i];
+    const Candidate* best = nullptr;
+    for (const auto& c : devices) {
+      if (c.vendor != s.vendorId || c.product != s.productCode) continue;
+      if (s.revisionNo && c.revision == *s.revisionNo) {
+        best = &c;
+        break;
+      }
+      if (best == nullptr || c.revision > best->revision) best = &c;
+    }
+    if (best == nullptr) {
+      std::string dirs;
+      for (const auto& d : esiDirs) dirs += (dirs.empty() ? "" : ", ") + d.string();
+      return makeError(ErrorCode::kNotFound,
+                       eni.file.string() + ", line " + std::to_string(s.line) + ": slave '" +
+                           s.name + "' (vendor " + hex8(s.vendorId) + " product " +
+                           hex8(s.productCode) + "): no such device in the ESI files of " +
+                           (dirs.empty() ? "(no folder)" : dirs));
+    }
+    TopologySlave slave;
+    slave.name = s.name.empty() ? "slave" + std::to_string(i) : s.name;
+    slave.esiFile = best->file;
+    slave.productCode = best->product;
+    slave.revision = best->revision;
+    slave.line = s.line;
+    config.slaves.push_back(std::move(slave));
+    byAddress[s.physAddr] = i;
+  }
+  // Wiring: PreviousPort (parent's port -> this slave's port 0) when every slave after the
+  // first has one; otherwise a line.
+  bool tree = eni.slaves.size() > 1;
+  for (std::size_t i = 1; i < eni.slaves.size(); ++i) {
+    if (eni.slaves[i].previousPort() == nullptr) tree = false;
+  }
+  if (tree) {
+    for (std::size_t i = 1; i < eni.slaves.size(); ++i) {
+      const EniPreviousPort& p = *eni.slaves[i].previousPort();
+      TopologyLink link;
+      link.fromSlave = byAddress.at(p.physAddr);  // the reader checked it names a slave
+      link.fromPort = p.port;
+      link.toSlave = i;
+      link.toPort = 0;
+      link.line = eni.slaves[i].line;
+      config.links.push_back(link);
+    }
+    config.explicitLinks = true;
+  } else {
+    for (std::size_t i = 1; i < eni.slaves.size(); ++i) {
+      config.links.push_back({"", i - 1, 1, i, 0, 1.0, eni.slaves[i].line});
+    }
+  }
+  for (auto& l : config.links) {  // cable names as topology files get them
+    l.name = config.slaves[l.fromSlave].name + ":" + std::to_string(l.fromPort) + "-" +
+             config.slaves[l.toSlave].name + ":" + std::to_string(l.toPort);
+  }
+  return config;
+}
+
+Result<Network> buildNetworkFromEni(const std::filesystem::path& eniFile,
+                                    const std::vector<std::filesystem::path>& esiDirs) {
+  ECSIM_ASSIGN_OR_RETURN(EniConfig eni, loadEniFile(eniFile));
+  ECSIM_ASSIGN_OR_RETURN(TopologyConfig config, topologyFromEni(eni, esiDirs));
+  return buildNetwork(config);
+}
+
+}  // namespace ecsim::topology
