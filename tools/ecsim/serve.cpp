@@ -23,6 +23,7 @@
 #include "tools/ecsim/commands.hpp"
 #include "tools/ecsim/status_view.hpp"
 #include "topology/network_builder.hpp"
+#include "topology/network_from_eni.hpp"
 #include "topology/network_server.hpp"
 #include "topology/pcap_cable_tap.hpp"
 
@@ -31,6 +32,7 @@ namespace {
 
 struct ServeOptions {
   std::string topology;
+  std::string esiDir;  // ESI files for an ENI's devices; empty: the data folder's esi/
   std::vector<std::string> pcapLinks;  // NAME=FILE
   std::string iface;
   std::string veth;
@@ -98,7 +100,19 @@ int runServe(ServeOptions o) {
 
   topology::Network network;
   if (o.topology.empty() && o.slaves == 0) o.topology = defaultTopologyPath();
-  if (!o.topology.empty()) {
+  auto root = o.topology.empty() ? Result<std::string>(std::string()) : xmlRootName(o.topology);
+  if (root.ok() && *root == "EtherCATConfig") {  // an ENI: devices from the ESI folder
+    if (o.esiDir.empty()) {
+      o.esiDir = (std::filesystem::path(defaultTopologyPath()).parent_path().parent_path() / "esi")
+                     .string();
+    }
+    auto built = topology::buildNetworkFromEni(o.topology, {o.esiDir});
+    if (!built.ok()) {
+      fmt::print(stderr, "ecsim serve: {}\n", built.error().message());
+      return 1;
+    }
+    network = std::move(built).value();
+  } else if (!o.topology.empty()) {
     auto config = loadTopologyFile(o.topology);
     if (!config.ok()) {
       fmt::print(stderr, "ecsim serve: {}\n", config.error().message());
@@ -205,7 +219,10 @@ CommandRunner addServeCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("serve", "Answer an EtherCAT master on a network interface");
   cmd->add_option(
       "topology", opts->topology,
-      "Topology file (default: the demo network, or a line of --slaves generic slaves)");
+      "Topology file or ENI (EtherCATConfig) file (default: the demo network, or a line of "
+      "--slaves generic slaves)");
+  cmd->add_option("--esi-dir", opts->esiDir,
+                  "Folder of ESI files for an ENI's devices (default: the examples' esi/)");
   cmd->add_option("--pcap-link", opts->pcapLinks, "Capture the cable NAME to FILE (NAME=FILE)");
   cmd->add_option("--iface", opts->iface, "Interface to serve (e.g. one end of a veth pair)");
   cmd->add_option("--veth", opts->veth, "Create veth pair NAME for this run (master end NAME)");
