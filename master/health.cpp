@@ -98,6 +98,17 @@ HealthMonitor::HealthMonitor(Transport& transport, std::vector<SlaveInfo>& slave
     h.alStatus = slaves[i].alStatus;
     h.alStatusCode = slaves[i].alStatusCode;
   }
+  // The status reads and probes are made once, so that queueing them never allocates.
+  for (std::size_t i = 0; i < slaves.size(); ++i) {
+    reads_.add().fprd(slaves[i].station, reg::kAlStatus.address, kAlStatusLength);
+    probes_.add().prepare(Command::kAprd,
+                          DatagramHeader::physical(Datagram::autoIncrement(i),
+                                                   reg::kConfiguredStationAddress.address),
+                          2, 1);
+  }
+  readPositions_.reserve(slaves.size());
+  probed_.reserve(slaves.size());
+  events_.reserve(64);
   options_.statusInterval = std::max<std::uint64_t>(options_.statusInterval, 1);
   options_.lostAfter = std::max(options_.lostAfter, 1u);
 }
@@ -156,32 +167,28 @@ void HealthMonitor::afterCycle(const CycleResult& result, std::uint64_t cycle, S
 }
 
 void HealthMonitor::queueStatusReads() {
-  reads_.clear();
   readPositions_.clear();
-  probes_.clear();
   probed_.clear();
   for (std::size_t i = 0; i < slaves_.size(); ++i) {
     const Watch& w = slaves_[i];
     if (w.recovery) continue;
-    reads_.add().fprd(slaveInfos_[i].station, reg::kAlStatus.address, kAlStatusLength);
+    Datagram& read = reads_[readPositions_.size()];
+    read.fprd(slaveInfos_[i].station, reg::kAlStatus.address, kAlStatusLength);
+    transport_.queue(read);
     readPositions_.push_back(i);
     if (w.health.condition == SlaveCondition::kLost ||
         w.health.condition == SlaveCondition::kFailed) {
-      probes_.add().prepare(Command::kAprd,
-                            DatagramHeader::physical(Datagram::autoIncrement(i),
-                                                     reg::kConfiguredStationAddress.address),
-                            2, 1);
+      Datagram& probe = probes_[probed_.size()];
+      probe.prepare(Command::kAprd,
+                    DatagramHeader::physical(Datagram::autoIncrement(i),
+                                             reg::kConfiguredStationAddress.address),
+                    2, 1);
+      transport_.queue(probe);
       probed_.push_back(i);
     }
   }
-  if (!reads_.empty()) {
-    reads_.queueAll(transport_);
-    readsOut_ = true;
-  }
-  if (!probes_.empty()) {
-    probes_.queueAll(transport_);
-    probesOut_ = true;
-  }
+  readsOut_ = !readPositions_.empty();
+  probesOut_ = !probed_.empty();
 }
 
 void HealthMonitor::takeStatusReads(std::uint64_t cycle, SimTime now) {

@@ -136,9 +136,9 @@ class HealthMonitor {
   HealthOptions options_;
   StateChangeOptions state_;
   std::vector<Watch> slaves_;
-  DatagramBatch reads_;
+  DatagramBatch reads_;  // one per slave, made once; the first readPositions_.size() in use
   bool readsOut_{false};
-  DatagramBatch probes_;  // APRD 0x0010 of lost slaves, by position
+  DatagramBatch probes_;  // APRD 0x0010 of lost slaves, by position; like reads_
   std::vector<std::size_t> probed_;
   bool probesOut_{false};
   std::uint64_t lastRead_{0};
