@@ -87,6 +87,7 @@ Result<TopologySlave> parseSlave(const xml::Context& ctx, const Element* e,
     }
   }
   if (const char* state = e->Attribute("stateFile")) s.stateFile = folder / state;
+  s.folder = folder;
   for (const Element* in : xml::Children(e, "Input")) {
     TopologyInput input;
     input.line = in->GetLineNum();

@@ -43,8 +43,9 @@ struct TopologySlave {
   std::int64_t clockOffsetNs{0};
   double driftPpm{0.0};
   std::vector<TopologyInput> inputs;
-  std::filesystem::path stateFile;  // persistent device state (e.g. absolute encoder)
+  std::filesystem::path stateFile;    // persistent device state (e.g. absolute encoder)
   std::vector<TopologyParam> params;  // device model parameters, in the written order
+  std::filesystem::path folder;       // the topology file's folder (for files params name)
   int line{0};
 };
 

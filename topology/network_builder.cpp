@@ -86,7 +86,8 @@ Result<std::unique_ptr<slavesim::Slave>> SlaveFactory::make(const TopologySlave&
     }
     std::vector<slavesim::devices::DeviceParam> params;
     for (const auto& p : entry.params) params.push_back({p.name, p.value, p.line});
-    if (auto s = slavesim::devices::applyDeviceParams(options.models, params); !s.ok()) {
+    if (auto s = slavesim::devices::applyDeviceParams(options.models, params, entry.folder);
+        !s.ok()) {
       return s.takeError();
     }
   }

@@ -36,6 +36,19 @@ Status installDrive(ProcessDataDevice& device, Result<std::unique_ptr<T>> model,
   return okStatus();
 }
 
+template <typename Terminal>
+Status applyScripts(Terminal& terminal, const std::vector<std::pair<unsigned, Signal>>& scripts) {
+  for (const auto& [channel, signal] : scripts) {
+    if (channel < 1 || channel > terminal.channels()) {
+      return makeError(ErrorCode::kInvalidArgument, "signal." + std::to_string(channel) +
+                                                        ": the terminal has channels 1.." +
+                                                        std::to_string(terminal.channels()));
+    }
+    terminal.setScript(channel, signal);
+  }
+  return okStatus();
+}
+
 }  // namespace
 
 DeviceModelKind deviceModelFor(std::uint32_t vendorId, std::uint32_t productCode,
@@ -63,6 +76,11 @@ Status attachDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,
                          const DeviceModelOptions& options) {
   device.setApplication(nullptr);  // the old model goes first (and saves its state)
   coe::ObjectDictionary& od = device.dictionary();
+  if (!options.scripts.empty() && kind != DeviceModelKind::kDigitalInputs &&
+      kind != DeviceModelKind::kAnalogInputs) {
+    return makeError(ErrorCode::kInvalidArgument,
+                     "input scripts (signal.N) need a digital or analog input terminal");
+  }
   DriveParams drive = options.drive;
   if (!options.stateFile.empty()) drive.stateFile = options.stateFile;
   if (options.encoderResolutionSet) {
@@ -75,12 +93,20 @@ Status attachDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,
   switch (kind) {
     case DeviceModelKind::kNone:
       return okStatus();
-    case DeviceModelKind::kDigitalInputs:
-      return install(device, DigitalInputTerminal::create(od));
+    case DeviceModelKind::kDigitalInputs: {
+      ECSIM_ASSIGN_OR_RETURN(auto terminal, DigitalInputTerminal::create(od));
+      ECSIM_TRY(applyScripts(*terminal, options.scripts));
+      device.setApplication(std::move(terminal));
+      return okStatus();
+    }
     case DeviceModelKind::kDigitalOutputs:
       return install(device, DigitalOutputTerminal::create(od));
-    case DeviceModelKind::kAnalogInputs:
-      return install(device, AnalogInputTerminal::create(od, 2, options.analog));
+    case DeviceModelKind::kAnalogInputs: {
+      ECSIM_ASSIGN_OR_RETURN(auto terminal, AnalogInputTerminal::create(od, 2, options.analog));
+      ECSIM_TRY(applyScripts(*terminal, options.scripts));
+      device.setApplication(std::move(terminal));
+      return okStatus();
+    }
     case DeviceModelKind::kCia402Drive:
       return installDrive(device, Cia402Drive::create(od, drive), options.emergencies);
     case DeviceModelKind::kRobotDrive:
@@ -238,11 +264,21 @@ Result<bool> applyPlain(DeviceModelOptions& o, const DeviceParam& p) {
 
 }  // namespace
 
-Status applyDeviceParams(DeviceModelOptions& options, const std::vector<DeviceParam>& params) {
+Status applyDeviceParams(DeviceModelOptions& options, const std::vector<DeviceParam>& params,
+                         const std::filesystem::path& baseDir) {
   double velocityHz = 100.0;
   double currentHz = 1000.0;
   bool anyGain = false;
   for (const DeviceParam& p : params) {
+    if (p.name.rfind("signal.", 0) == 0) {
+      const DeviceParam channelText{"", p.name.substr(7), p.line};
+      auto channel = integer<unsigned>(channelText, 1, 64);
+      if (!channel.ok()) return paramError(p, "the channel after 'signal.' must be 1..64");
+      auto signal = parseSignal(p.value, baseDir);
+      if (!signal.ok()) return paramError(p, signal.error().message());
+      options.scripts.emplace_back(*channel, std::move(signal).value());
+      continue;
+    }
     if (p.name.rfind("gains.", 0) == 0) {
       anyGain = true;
       if (p.name == "gains.velocityHz") {

@@ -16,6 +16,8 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <utility>
+#include <vector>
 
 #include "protocol/result.hpp"
 #include "slavesim/devices/cia402_drive.hpp"
@@ -46,9 +48,12 @@ struct DeviceModelOptions {
   // dictionary with 0x2011 gives it.
   bool encoderResolutionSet{false};
   EmergencySink emergencies;  // drives: where their emergency messages go
+  // Input terminals: scripted channels (1-based; digital on at >= 0.5, analog in volts).
+  std::vector<std::pair<unsigned, Signal>> scripts;
 };
 
-// Attaches the model to `device` (kNone: removes any). A previous model is destroyed first, so
+// Attaches the model to `device` (kNone: removes any). Scripts for a model without scripted
+// inputs, or for a channel it does not have, are an error. A previous model is destroyed first, so
 // a drive saves its state file before its successor reads it (a simulated power cycle).
 // Drives take the encoder resolution from 0x2011 when the dictionary has it.
 Status attachDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,

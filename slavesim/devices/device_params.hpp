@@ -15,11 +15,16 @@
 //              (counts/s^2), homeOffset (counts), initialShaftAngle (rad), initTimeMs,
 //              faultReactionTimeoutMs
 //   analog.*   fullScaleVolts, conversionPeriodUs
+//   signal.N   input terminals: channel N driven by a script in the text form of signal.hpp
+//              ("square period=0.5", "sine amplitude=5 frequency=2", "csv file=trace.csv"),
+//              digital channels on at >= 0.5, analog channels in volts; CSV files relative to
+//              `baseDir` (the topology file's folder)
 // The gains are resolved after all other parameters, so their order in the file does not
 // matter. An unknown name or a value that is not a number of the right range is an error
 // naming the parameter's line.
 #pragma once
 
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -34,6 +39,7 @@ struct DeviceParam {
   int line{0};  // for error messages; 0: not from a file
 };
 
-Status applyDeviceParams(DeviceModelOptions& options, const std::vector<DeviceParam>& params);
+Status applyDeviceParams(DeviceModelOptions& options, const std::vector<DeviceParam>& params,
+                         const std::filesystem::path& baseDir = {});
 
 }  // namespace ecsim::slavesim::devices

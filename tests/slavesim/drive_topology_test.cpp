@@ -12,6 +12,7 @@
 #include "config/topology_file.hpp"
 #include "slavesim/devices/device_models.hpp"
 #include "slavesim/devices/device_params.hpp"
+#include "slavesim/devices/io_terminals.hpp"
 #include "tests/slavesim/drive_test_support.hpp"
 #include "topology/network_builder.hpp"
 
@@ -107,6 +108,49 @@ TEST_F(DriveTopology, BadValuesAndParamsOnModellessDevicesAreErrors) {
   ASSERT_FALSE(coupler.ok());
   EXPECT_NE(coupler.error().message().find("no model"), std::string::npos)
       << coupler.error().message();
+}
+
+TEST_F(DriveTopology, SignalParamsScriptTheInputTerminals) {
+  std::ofstream(dir_ / "trace.csv") << "time,value\n0,0\n0.010,10\n";
+  auto di = build(write("",
+                        "    <Param name=\"signal.2\" value=\"square period=0.004\"/>\n"
+                        "    <Param name=\"signal.8\" value=\"1\"/>\n",
+                        0x00001008));
+  ASSERT_TRUE(di.ok()) << di.error().message();
+  dev::DigitalInputTerminal* inputs = dev::digitalInputsOf(di->segment->slave(0));
+  ASSERT_NE(inputs, nullptr);
+  di->segment->pollSlaves(1 * kNsPerMs);
+  EXPECT_TRUE(inputs->input(2)) << "first half of the square period";
+  EXPECT_TRUE(inputs->input(8));
+  EXPECT_FALSE(inputs->input(1)) << "no script";
+  di->segment->pollSlaves(3 * kNsPerMs);
+  EXPECT_FALSE(inputs->input(2)) << "second half";
+
+  auto ai =
+      build(write("", "    <Param name=\"signal.1\" value=\"csv file=trace.csv\"/>\n", 0x00003102));
+  ASSERT_TRUE(ai.ok()) << ai.error().message();
+  dev::AnalogInputTerminal* analog = dev::analogInputsOf(ai->segment->slave(0));
+  ASSERT_NE(analog, nullptr);
+  ai->segment->pollSlaves(0);
+  ai->segment->pollSlaves(5 * kNsPerMs);
+  auto* od = slavesim::objectDictionaryOf(ai->segment->slave(0));
+  // 5 V of the CSV ramp (relative to the topology's folder), filtered (10 ms default) below it.
+  const auto raw = *od->get<std::int16_t>(0x6000, 0x11);
+  EXPECT_GT(raw, 0);
+  EXPECT_LE(raw, analog->rawValue(5.0));
+
+  for (const char* bad : {"<Param name=\"signal.x\" value=\"1\"/>",
+                          "<Param name=\"signal.1\" value=\"triangle period=1\"/>"}) {
+    auto net = build(write("", std::string("    ") + bad + "\n", 0x00001008));
+    ASSERT_FALSE(net.ok()) << bad;
+    EXPECT_NE(net.error().message().find("line 3"), std::string::npos) << net.error().message();
+  }
+  auto channel = build(write("", "    <Param name=\"signal.9\" value=\"1\"/>\n", 0x00001008));
+  ASSERT_FALSE(channel.ok());
+  EXPECT_NE(channel.error().message().find("channels 1..8"), std::string::npos)
+      << channel.error().message();
+  auto drive = build(write("", "    <Param name=\"signal.1\" value=\"1\"/>\n"));
+  ASSERT_FALSE(drive.ok()) << "a drive has no scripted inputs";
 }
 
 TEST(DeviceParams, AnalogAndAxisParameters) {
