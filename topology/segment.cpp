@@ -17,6 +17,7 @@ std::size_t Segment::addSlave(std::unique_ptr<slavesim::Slave> slave) {
   const auto& type = slave->esc().type();
   slaves_.push_back(std::move(slave));
   links_.push_back({});
+  cableNs_.push_back({});
   linkUp_.push_back({true, true, true, true});
   delays_.push_back({type.processingDelayNs, type.forwardingDelayNs});
   parent_.push_back(static_cast<int>(slaves_.size() - 1));
@@ -25,6 +26,8 @@ std::size_t Segment::addSlave(std::unique_ptr<slavesim::Slave> slave) {
   openMask_.push_back(0);
   observers_.push_back({});
   stack_.reserve(slaves_.size() + 1);
+  escs_.push_back(&slaves_.back()->esc());
+  latched_.reserve(slaves_.size());
   refreshLinkStatus();
   return slaves_.size() - 1;
 }
@@ -57,6 +60,7 @@ Status Segment::connect(std::size_t a, unsigned pa, std::size_t b, unsigned pb, 
   parent_[static_cast<std::size_t>(rb)] = ra;
   links_[a][pa] = {static_cast<int>(b), static_cast<std::uint8_t>(pb), metres};
   links_[b][pb] = {static_cast<int>(a), static_cast<std::uint8_t>(pa), metres};
+  cableNs_[a][pa] = cableNs_[b][pb] = cableDelay(metres);
   refreshLinkStatus();
   return okStatus();
 }
@@ -64,6 +68,12 @@ Status Segment::connect(std::size_t a, unsigned pa, std::size_t b, unsigned pb, 
 void Segment::wireLine(double metres) {
   for (std::size_t i = 1; i < slaves_.size(); ++i) {
     (void)connect(i - 1, 1, i, 0, metres);
+  }
+}
+
+void Segment::updateCableDelays() {
+  for (std::size_t i = 0; i < slaves_.size(); ++i) {
+    for (unsigned p = 0; p < kPortCount; ++p) cableNs_[i][p] = cableDelay(links_[i][p].cableMetres);
   }
 }
 
@@ -125,11 +135,14 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
     if (!parsed.ok()) ++counters_.framesMalformed;
     return outcome;
   }
+  // Each ESC processes a datagram when its first byte passes: preamble and SFD (8 bytes), then
+  // the datagram's offset in the frame, after the frame's first bit arrived.
+  const SimTime nsPerByte = timing_.nsPerByte;
   std::size_t count = 0;
-  std::array<std::size_t, 128> offsets{};
+  std::array<SimTime, 128> leads;
   for (auto it = parsed->begin(); it != parsed->end() && count < datagrams_.size(); ++it) {
     datagrams_[count] = *it;
-    offsets[count] = parsed->datagramsOffset() + it.offset();
+    leads[count] = static_cast<SimTime>(8 + parsed->datagramsOffset() + it.offset()) * nsPerByte;
     ++count;
   }
   if (count == datagrams_.size()) {  // more datagrams than an EtherCAT frame can hold
@@ -140,10 +153,8 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
   counters_.datagramsProcessed += count;
   frame[6] |= 0x02;  // an ESC sets the locally administered bit of the source MAC (§3)
 
-  const SimTime nsPerByte = timing_.nsPerByte;
-  // The first bit of the frame is preceded by preamble and SFD: header bytes pass after them.
-  const SimTime headerLead = 8 * nsPerByte;
   stack_.clear();
+  latched_.clear();
   for (auto& m : arrivalMask_) m = 0;
   std::uint32_t s = 0;
   std::uint8_t k = 0;
@@ -160,12 +171,13 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
   bool viaEpu = false;
   while (true) {
     if (k == 0) {
-      auto& esc = slaves_[s]->esc();
+      slavesim::Esc& esc = *escs_[s];
       esc.beginFrame();
       for (std::size_t i = 0; i < (bad ? 0 : count); ++i) {
-        SimTime at = t + headerLead + static_cast<SimTime>(offsets[i]) * nsPerByte;
-        esc.processDatagram(datagrams_[i], at);
+        esc.processDatagram(datagrams_[i], t + leads[i]);
       }
+      // Only a datagram of this frame can arm the latch; it completes once the frame is through.
+      if (esc.receiveTimeLatchArmed()) latched_.push_back(s);
       viaEpu = true;
     }
     const std::uint8_t out = kNextPort[k];
@@ -186,12 +198,11 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
         break;
       }
       Visit& parent = stack_.back();
-      const PortLink& l = links_[parent.slave][parent.port];
       notify(s, entry, frame, tOut, false);
       notify(parent.slave, parent.port, frame, tOut, false);
       s = parent.slave;
       k = parent.port;
-      t = tOut + cableDelay(l.cableMetres);
+      t = tOut + cableNs_[s][k];  // the cable just crossed (both ends hold its delay)
     } else {
       const PortLink& l = links_[s][out];
       notify(s, out, frame, tOut, true);
@@ -200,17 +211,14 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
       stack_.push_back({static_cast<std::uint32_t>(l.slave), l.port, l.port});
       s = static_cast<std::uint32_t>(l.slave);
       k = l.port;
-      t = tOut + cableDelay(l.cableMetres);
+      t = tOut + cableNs_[s][k];  // the cable just crossed (both ends hold its delay)
     }
     if (faults_ != nullptr) arriveWithFaults(s, k, t, bad);
     arrival_[s][k] = t;
     arrivalMask_[s] = static_cast<std::uint8_t>(arrivalMask_[s] | (1u << k));
   }
-  for (std::size_t i = 0; i < slaves_.size(); ++i) {
-    auto& esc = slaves_[i]->esc();
-    if (esc.receiveTimeLatchArmed()) {
-      esc.completeReceiveTimeLatch(arrival_[i], arrivalMask_[i]);
-    }
+  for (const std::uint32_t i : latched_) {
+    escs_[i]->completeReceiveTimeLatch(arrival_[i], arrivalMask_[i]);
   }
   // The master has the frame when its last bit is in: wire footprint of the frame itself
   // (preamble + SFD + frame + FCS).

@@ -116,7 +116,10 @@ class Segment {
 
   const SegmentCounters& counters() const { return counters_; }
   const TimingModel& timing() const { return timing_; }
-  void setTiming(const TimingModel& t) { timing_ = t; }
+  void setTiming(const TimingModel& t) {
+    timing_ = t;
+    updateCableDelays();
+  }
 
  private:
   bool portOpen(std::size_t slave, unsigned port) const;
@@ -126,6 +129,8 @@ class Segment {
 
   std::vector<std::unique_ptr<slavesim::Slave>> slaves_;
   std::vector<std::array<PortLink, kPortCount>> links_;
+  std::vector<std::array<SimTime, kPortCount>> cableNs_;  // cableDelay() of links_, both ends
+  void updateCableDelays();
   std::vector<std::array<bool, kPortCount>> linkUp_;
   std::vector<std::array<SimTime, 2>> delays_;  // processing, forwarding
   std::vector<int> parent_;                     // union-find for the tree check
@@ -155,6 +160,8 @@ class Segment {
     std::uint8_t port;  // port at which the frame currently is (received on)
   };
   std::vector<Visit> stack_;
+  std::vector<slavesim::Esc*> escs_;    // slaves_[i]->esc(), one indirection less per visit
+  std::vector<std::uint32_t> latched_;  // slaves whose receive-time latch this frame armed
 };
 
 }  // namespace ecsim::topology
