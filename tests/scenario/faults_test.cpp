@@ -1,0 +1,162 @@
+// Fault injection on a small line of generic slaves, through frames: corruption counted in the
+// ESC error counters (0x0300 invalid frame at the receiving port, 0x0308 forwarded errors after
+// it), seeded loss, link down and power cycle.
+#include <gtest/gtest.h>
+
+#include "protocol/ethernet.hpp"
+#include "protocol/frame.hpp"
+#include "slavesim/generic_slave.hpp"
+#include "topology/faults.hpp"
+#include "topology/network_builder.hpp"
+
+namespace ecsim::topology {
+namespace {
+
+Network makeLine(std::size_t n) {
+  Network net;
+  net.segment = std::make_unique<Segment>();
+  for (std::size_t i = 0; i < n; ++i) {
+    net.segment->addSlave(
+        slavesim::makeGenericSlave("S" + std::to_string(i), static_cast<std::uint32_t>(i)));
+  }
+  net.segment->wireLine();
+  net.cables.push_back({"master", 0, 0});
+  for (std::size_t i = 1; i < n; ++i) net.cables.push_back({"c" + std::to_string(i), i, 0});
+  return net;
+}
+
+// A BRD of the type register: every slave it passes adds one to the WKC.
+std::vector<std::uint8_t> brdFrame() {
+  std::vector<std::uint8_t> buf(kMaxFrameSize);
+  FrameBuilder b(
+      buf, EthernetHeader{kBroadcastMac, {1, 1, 1, 1, 1, 1}, std::nullopt, kEtherTypeEtherCat});
+  EXPECT_TRUE(b.add(Command::kBrd, 1, 0, 2).ok());
+  auto len = b.finish();
+  EXPECT_TRUE(len.ok());
+  buf.resize(*len);
+  return buf;
+}
+
+std::uint16_t firstWkc(std::vector<std::uint8_t>& frame) {
+  auto parsed = EtherCatFrame::parse(frame);
+  EXPECT_TRUE(parsed.ok());
+  return parsed.ok() ? (*parsed->begin()).wkc() : 0;
+}
+
+FaultAction action(const std::string& line) {
+  auto a = parseFaultAction(line);
+  EXPECT_TRUE(a.ok()) << line;
+  return *a;
+}
+
+TEST(Faults, CorruptionIsCountedAtTheReceiverAndForwardedAfterIt) {
+  Network net = makeLine(4);
+  FaultInjector faults(net, 1);
+  ASSERT_TRUE(faults.apply(action("corrupt cable=c2 count=2"), 0).ok());
+  for (int i = 0; i < 3; ++i) {
+    auto frame = brdFrame();
+    auto out = net.segment->processFrame(frame, static_cast<SimTime>(i) * 100000);
+    EXPECT_EQ(out.delivered, i >= 2) << "frame " << i;
+  }
+  auto& seg = *net.segment;
+  // S2 received the bad frames at port 0: invalid frame counter 0x0300.
+  EXPECT_EQ(seg.slave(2).esc().reg8(0x0300), 2);
+  // S3 after it: forwarded error at port 0; on the way back S2, S1, S0 at port 1.
+  EXPECT_EQ(seg.slave(3).esc().reg8(0x0308), 2);
+  EXPECT_EQ(seg.slave(2).esc().reg8(0x0309), 2);
+  EXPECT_EQ(seg.slave(1).esc().reg8(0x0309), 2);
+  EXPECT_EQ(seg.slave(0).esc().reg8(0x0309), 2);
+  // Upstream of the fault nothing was wrong on the way down.
+  EXPECT_EQ(seg.slave(1).esc().reg8(0x0300), 0);
+  EXPECT_EQ(seg.slave(1).esc().reg8(0x0308), 0);
+}
+
+TEST(Faults, SeededLossIsRepeatable) {
+  auto run = [](std::uint64_t seed) {
+    Network net = makeLine(2);
+    FaultInjector faults(net, seed);
+    EXPECT_TRUE(faults.apply(action("loss rate=0.3"), 0).ok());
+    std::string pattern;
+    for (int i = 0; i < 200; ++i) {
+      auto frame = brdFrame();
+      pattern +=
+          net.segment->processFrame(frame, static_cast<SimTime>(i) * 100000).delivered ? '1' : '0';
+    }
+    return pattern;
+  };
+  const std::string a = run(42);
+  EXPECT_EQ(a, run(42));
+  EXPECT_NE(a, run(43));
+  const auto lost = std::count(a.begin(), a.end(), '0');
+  EXPECT_GT(lost, 30);
+  EXPECT_LT(lost, 90);
+}
+
+TEST(Faults, LinkDownClosesBothEndsAndCountsLostLinks) {
+  Network net = makeLine(3);
+  FaultInjector faults(net, 1);
+  ASSERT_TRUE(faults.apply(action("link-down cable=c2"), 0).ok());
+  auto frame = brdFrame();
+  ASSERT_TRUE(net.segment->processFrame(frame, 0).delivered);
+  EXPECT_EQ(firstWkc(frame), 2);  // S2 is cut off
+  EXPECT_EQ(net.segment->slave(1).esc().reg8(0x0311), 1);
+  EXPECT_EQ(net.segment->slave(2).esc().reg8(0x0310), 1);
+  ASSERT_TRUE(faults.apply(action("link-up cable=c2"), 0).ok());
+  frame = brdFrame();
+  ASSERT_TRUE(net.segment->processFrame(frame, 0).delivered);
+  EXPECT_EQ(firstWkc(frame), 3);
+}
+
+TEST(Faults, PowerCycleResetsRegistersAndEepromChecksumKeepsThePdiOff) {
+  Network net = makeLine(2);
+  FaultInjector faults(net, 1);
+  auto& esc = net.segment->slave(1).esc();
+  esc.pdiWrite16(0x0010, 0x1002);
+  ASSERT_TRUE(faults.apply(action("power-off slave=S1"), 0).ok());
+  auto frame = brdFrame();
+  ASSERT_TRUE(net.segment->processFrame(frame, 0).delivered);
+  EXPECT_EQ(firstWkc(frame), 1);
+  ASSERT_TRUE(faults.apply(action("power-on slave=S1"), 0).ok());
+  EXPECT_EQ(esc.reg16(0x0010), 0);
+  EXPECT_NE(esc.reg16(0x0110) & 0x0001, 0);  // EEPROM loaded, PDI operational
+  EXPECT_TRUE(net.segment->slave(1).firmwareRunning());
+  ASSERT_TRUE(faults.apply(action("eeprom-checksum slave=S1"), 0).ok());
+  EXPECT_EQ(esc.reg16(0x0110) & 0x0001, 0);
+  EXPECT_NE(esc.reg16(0x0502) & 0x0800, 0);  // checksum error
+  EXPECT_FALSE(net.segment->slave(1).firmwareRunning());
+}
+
+TEST(Faults, AlErrorSetsTheFlagAndCode) {
+  Network net = makeLine(1);
+  FaultInjector faults(net, 1);
+  ASSERT_TRUE(faults.apply(action("al-error slave=S0 code=0x001A state=INIT"), 0).ok());
+  EXPECT_EQ(net.segment->slave(0).esc().alStatus(), 0x0011);
+  EXPECT_EQ(net.segment->slave(0).esc().reg16(0x0134), 0x001A);
+}
+
+TEST(Faults, ErrorsNameWhatIsWrong) {
+  Network net = makeLine(1);
+  FaultInjector faults(net, 1);
+  auto r = faults.apply(action("link-down cable=nowhere"), 0);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().context.find("nowhere"), std::string::npos);
+  r = faults.apply(action("al-error slave=S0"), 0);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().context.find("code"), std::string::npos);
+  EXPECT_FALSE(FaultInjector::handles("explode"));
+}
+
+TEST(FaultAction, ParsesQuotedValuesAndRoundTrips) {
+  auto a = parseFaultAction("input slave=DI1 channel=2 signal=\"square period=0.2 low=0 high=1\"");
+  ASSERT_TRUE(a.ok());
+  EXPECT_EQ(a->verb, "input");
+  EXPECT_EQ(a->args.at("signal"), "square period=0.2 low=0 high=1");
+  auto again = parseFaultAction(a->text());
+  ASSERT_TRUE(again.ok());
+  EXPECT_EQ(again->args, a->args);
+  EXPECT_FALSE(parseFaultAction("link-down cable").ok());
+  EXPECT_FALSE(parseFaultAction("input signal=\"open").ok());
+}
+
+}  // namespace
+}  // namespace ecsim::topology

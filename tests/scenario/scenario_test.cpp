@@ -1,0 +1,116 @@
+// The scenario format (errors name file and line), the runner on the demo network, and the
+// determinism a CI system relies on: the same scenario and seed give the same report and pcap.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "scenario/runner.hpp"
+#include "scenario/scenario.hpp"
+
+namespace ecsim::scenario {
+namespace {
+
+const std::filesystem::path kDir = std::filesystem::path(ECSIM_SOURCE_DIR) / "scenarios";
+
+std::string wrap(const std::string& body) {
+  return "<?xml version=\"1.0\"?>\n<Scenario name=\"t\" topology=\"demo.xml\" cycleUs=\"1000\" "
+         "durationMs=\"100\">\n" +
+         body + "</Scenario>\n";
+}
+
+TEST(ScenarioFile, ReadsActionsAndExpectations) {
+  auto s =
+      parseScenario(wrap("<Timeline>\n"
+                         "  <Action cycle=\"5\" do=\"link-down\" cable=\"drives\"/>\n"
+                         "  <Action timeMs=\"7.5\" do=\"link-up\" cable=\"drives\"/>\n"
+                         "</Timeline>\n<Expect>\n"
+                         "  <State slave=\"DI1\" state=\"OP\" atMs=\"50\"/>\n"
+                         "  <Register slave=\"DI1\" address=\"0x0310\" op=\"ge\" value=\"1\"/>\n"
+                         "</Expect>\n"),
+                    "/x/s.xml");
+  ASSERT_TRUE(s.ok()) << s.error().message();
+  EXPECT_EQ(s->topology, std::filesystem::path("/x/demo.xml"));
+  ASSERT_EQ(s->actions.size(), 2u);
+  EXPECT_EQ(s->actions[0].cycle, 5u);
+  EXPECT_EQ(s->actions[1].time, 7500000);
+  EXPECT_EQ(s->actions[1].action.args.at("cable"), "drives");
+  ASSERT_EQ(s->expectations.size(), 2u);
+  EXPECT_EQ(s->expectations[1].compare, Compare::kGe);
+  EXPECT_EQ(s->expectations[1].address, 0x0310);
+  EXPECT_EQ(s->expectations[0].line, 8);
+}
+
+TEST(ScenarioFile, ErrorsNameFileAndLine) {
+  auto s = parseScenario(wrap("<Timeline>\n  <Action do=\"link-down\"/>\n</Timeline>\n"
+                              "<Expect><State slave=\"A\" state=\"OP\"/></Expect>\n"),
+                         "bad.xml");
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().context.find("bad.xml, line 4"), std::string::npos) << s.error().context;
+  s = parseScenario(wrap("<Expect>\n<State slave=\"A\" state=\"RUNNING\"/></Expect>\n"), "b.xml");
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().context.find("b.xml, line 4"), std::string::npos) << s.error().context;
+  s = parseScenario(wrap("<Timeline><Action cycle=\"1\" do=\"explode\"/></Timeline>"
+                         "<Expect><State slave=\"A\" state=\"OP\"/></Expect>"),
+                    "c.xml");
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().context.find("explode"), std::string::npos);
+}
+
+TEST(Runner, AFailingExpectationSaysWhatWhenAndWhat) {
+  auto s = loadScenario(kDir / "cable_break.xml");
+  ASSERT_TRUE(s.ok()) << s.error().message();
+  // Ask for the impossible: Drive1 in OP while its cable is pulled.
+  Expectation x;
+  x.line = 999;
+  x.kind = ExpectKind::kState;
+  x.slave = "Drive1";
+  x.state = "OP";
+  x.atCycle = 700;
+  s->expectations.push_back(x);
+  s->duration = 1000 * kNsPerMs;
+  auto r = runScenario(*s);
+  ASSERT_TRUE(r.error.empty()) << r.error;
+  EXPECT_FALSE(r.passed());
+  const std::string report = formatReport(r);
+  EXPECT_NE(report.find("FAIL  cable_break.xml, line 999: State Drive1 is OP at cycle 700"),
+            std::string::npos)
+      << report;
+  EXPECT_NE(report.find("at 700.000 ms: SAFEOP"), std::string::npos) << report;
+  const std::string junit = formatJunit({r});
+  EXPECT_NE(junit.find("<failure message=\"at 700.000 ms: SAFEOP"), std::string::npos) << junit;
+}
+
+std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+TEST(Runner, SameSeedSameReportAndCapture) {
+  auto s = loadScenario(kDir / "frame_loss.xml");
+  ASSERT_TRUE(s.ok()) << s.error().message();
+  s->duration = 700 * kNsPerMs;
+  const auto dir = std::filesystem::temp_directory_path() / "ecsim_scenario_test";
+  std::filesystem::create_directories(dir / "a");
+  std::filesystem::create_directories(dir / "b");
+  RunOptions a;
+  a.pcapDir = dir / "a";
+  RunOptions b;
+  b.pcapDir = dir / "b";
+  const auto ra = formatReport(runScenario(*s, a));
+  const auto rb = formatReport(runScenario(*s, b));
+  EXPECT_EQ(ra, rb);
+  const auto pa = slurp(dir / "a" / "frame_loss.pcap");
+  EXPECT_GT(pa.size(), 10000u);
+  EXPECT_EQ(pa, slurp(dir / "b" / "frame_loss.pcap"));
+  RunOptions c;
+  c.seed = 99;
+  EXPECT_NE(formatReport(runScenario(*s, c)), ra);  // another seed, other losses
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace ecsim::scenario
