@@ -104,6 +104,19 @@ TEST(Encoder, QuantisationStep) {
   }
 }
 
+TEST(Encoder, FaultFreezesTheReadingUntilCleared) {
+  dev::Encoder e(params(dev::EncoderKind::kAbsoluteMultiTurn, 1000, 4));
+  e.powerOn(0.0);
+  EXPECT_EQ(e.read(2.5005 * kTurn).counts, 2500);
+  e.setFault(true);
+  EXPECT_TRUE(e.faulted());
+  const auto frozen = e.read(3.7505 * kTurn);
+  EXPECT_EQ(frozen.counts, 2500) << "the last good reading";
+  EXPECT_EQ(frozen.reported, 2500);
+  e.setFault(false);
+  EXPECT_EQ(e.read(3.7505 * kTurn).counts, 3750);
+}
+
 TEST(Encoder, SeededNoiseIsReproducibleAndHasItsStandardDeviation) {
   dev::EncoderParams p = params(dev::EncoderKind::kAbsoluteMultiTurn, 131072, 15);
   p.noiseCounts = 4.0;
