@@ -19,6 +19,8 @@
 #include "link/signal_flag.hpp"
 #include "link/tap_link.hpp"
 #include "link/veth_setup.hpp"
+#include "topology/control_server.hpp"
+#include "topology/faults.hpp"
 #include "slavesim/generic_slave.hpp"
 #include "tools/ecsim/commands.hpp"
 #include "tools/ecsim/status_view.hpp"
@@ -45,6 +47,7 @@ struct ServeOptions {
   bool realtime{false};
   bool status{false};      // live table on the terminal
   std::string statusJson;  // status rewritten periodically to this file
+  std::string control;     // live-injection socket; empty: /run/ecsim/<interface>.sock
 };
 
 // The built-in demo network: the installed copy, else the one in the source tree.
@@ -193,7 +196,27 @@ int runServe(ServeOptions o) {
     std::fflush(stdout);
   }
   StatusReporter reporter(o.status, o.statusJson);
+  // Live injection (docs/scenarios.md): fault actions as text lines on a Unix socket.
+  topology::FaultInjector faults(network, 1);
+  if (o.control.empty()) {
+    o.control = "/run/ecsim/" + (o.iface.empty() ? o.tap : o.iface) + ".sock";
+  }
+  auto control = topology::ControlServer::open(o.control);
+  if (!control.ok()) {
+    fmt::print(stderr, "ecsim serve: warning: no control socket: {}\n", control.error().message());
+  } else if (!o.quiet) {
+    fmt::print("ecsim: control socket {} (ecsim ctl --socket {} ACTION ...)\n", o.control,
+               o.control);
+    std::fflush(stdout);
+  }
+  auto handle = [&](std::string_view line) -> std::string {
+    auto action = topology::parseFaultAction(line);
+    if (!action.ok()) return "error " + action.error().context;
+    auto done = faults.apply(*action, clock.now());
+    return done.ok() ? "ok " + *done : "error " + done.error().context;
+  };
   auto status = server.run([&] {
+    if (control.ok()) control->poll(handle);
     reporter.tick(clock.now(), segment, server.counters());
     return stop.raised();
   });
@@ -231,6 +254,8 @@ CommandRunner addServeCommand(CLI::App& app) {
   cmd->add_option("--slaves", opts->slaves, "Serve a line of N generic slaves instead")
       ->check(CLI::Range(1u, 65535u));
   cmd->add_option("--pcap", opts->pcap, "Capture every frame to this pcap file");
+  cmd->add_option("--control", opts->control,
+                  "Control socket for live fault injection (default /run/ecsim/IFACE.sock)");
   cmd->add_flag("--paced", opts->paced, "Answer at the modelled round-trip time");
   cmd->add_flag("--quiet", opts->quiet, "Print only the final statistics");
   cmd->add_flag("--rt", opts->realtime, "Run with SCHED_FIFO priority and locked memory");
