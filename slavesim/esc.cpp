@@ -549,9 +549,16 @@ bool Esc::writeRegisters(std::uint16_t address, ConstBytes data) {
     // Fast path for the cyclic DC distribution (ARMW/FRMW of 0x0910 reaches every ESC but the
     // reference once per frame): no other register with side effects lies in this range.
     bool accepted = false;
-    if (data.size() == 8) {  // all of it: one 64-bit masked merge
-      const std::uint64_t mask = readLe64(writable_, begin);
-      writeLe64(memory_, begin, (reg64(address) & ~mask) | (readLe64(data, 0) & mask));
+    if (data.size() == 8) {
+      // All of it: one masked merge of 8 bytes at once (bitwise, so byte order is irrelevant).
+      std::uint64_t mask = 0;
+      std::uint64_t old = 0;
+      std::uint64_t value = 0;
+      std::memcpy(&mask, writable_.data() + begin, 8);
+      std::memcpy(&old, memory_.data() + begin, 8);
+      std::memcpy(&value, data.data(), 8);
+      const std::uint64_t merged = (old & ~mask) | (value & mask);
+      std::memcpy(memory_.data() + begin, &merged, 8);
       accepted = mask != 0;
     }
     for (std::uint32_t i = 0; data.size() != 8 && i < data.size(); ++i) {
