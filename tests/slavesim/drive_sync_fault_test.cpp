@@ -15,6 +15,13 @@ namespace {
 
 // ---- SYNC0 ------------------------------------------------------------------------------------
 
+template <typename T>
+std::vector<std::uint8_t> littleEndian(T v) {
+  std::vector<std::uint8_t> out(sizeof(T));
+  for (std::size_t i = 0; i < sizeof(T); ++i) out[i] = static_cast<std::uint8_t>(v >> (8 * i));
+  return out;
+}
+
 TEST(DriveSync, WithSync0TheDriveRunsOnThePulsesOnly) {
   DriveBench b;
   b.tick();  // started, in Switch on disabled
@@ -62,6 +69,45 @@ TEST(DriveSync, InputsAreLatchedAtTheSync0PulseAndTheModelAdvancesToIt) {
   const std::int32_t before = latched;
   b.drive->sync(*b.od, 0, b.al, pulse + kNsPerMs);
   EXPECT_NEAR(b.position() - before, 131.072, 15.0) << "one pulse period of motion";
+}
+
+// Through the ESC: the master activates the cyclic unit (0x0990 start, 0x09A0 cycle, 0x0981)
+// and from then on the drive takes its outputs only at the SYNC0 pulses the ESC generates.
+TEST(DriveSync, TheEscsSync0PulsesRunTheDrive) {
+  topology::Segment seg;
+  seg.addSlave(makeExampleSlave(kEcs7201));
+  auto op = bringToOp(seg, {{2, true, 13}, {3, false, 15}});
+  dev::Cia402Drive* drive = dev::driveOf(seg.slave(0));
+  ASSERT_NE(drive, nullptr);
+  auto write = [&](std::uint16_t ado, std::vector<std::uint8_t> data, SimTime t) {
+    one(seg, Command::kFpwr, phys(kStation, ado), std::move(data), t);
+  };
+  write(0x0990, littleEndian<std::uint64_t>(10 * kNsPerMs),
+        kNsPerMs);  // first pulse at system time 10 ms
+  write(0x09A0, littleEndian<std::uint32_t>(kNsPerMs), kNsPerMs);
+  write(0x0981, {0x03}, kNsPerMs);  // cyclic unit and SYNC0 on
+  ASSERT_TRUE(seg.slave(0).esc().syncActive(0));
+  seg.pollSlaves(9 * kNsPerMs);
+  EXPECT_EQ(seg.slave(0).syncPulses(), 0u);
+  seg.pollSlaves(10 * kNsPerMs);  // the first pulse
+  EXPECT_EQ(seg.slave(0).syncPulses(), 1u);
+  EXPECT_EQ(drive->state(), State::kSwitchOnDisabled);
+  // Shutdown arrives at 10.4 ms: firmware steps at 10.5 and 10.9 ms do not take it ...
+  std::vector<std::uint8_t> image(13 + 15, 0);
+  writeLe16(image, 0, 0x0006);
+  EXPECT_EQ(one(seg, Command::kLrw, 0, image, 10'400'000).wkc, 3);
+  const auto pulsesBefore = seg.slave(0).syncPulses();
+  seg.pollSlaves(10'500'000);
+  seg.pollSlaves(10'900'000);
+  EXPECT_EQ(drive->state(), State::kSwitchOnDisabled);
+  // ... the SYNC0 pulse at 11 ms does.
+  seg.pollSlaves(11'000'000);
+  EXPECT_EQ(drive->state(), State::kReadyToSwitchOn);
+  EXPECT_EQ(seg.slave(0).syncPulses() - pulsesBefore, 1u);
+  // The inputs in SM3 are those latched at the pulse: the statusword of Ready to switch on.
+  auto in = one(seg, Command::kLrw, 0, image, 11'200'000);
+  EXPECT_EQ(readLe16(in.data, 13) & 0x6F, 0x21) << std::hex << readLe16(in.data, 13);
+  (void)op;
 }
 
 TEST(IoSync, DigitalInputsLatchAndOutputsApplyAtSync0) {
