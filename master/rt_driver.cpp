@@ -53,6 +53,7 @@ Status RtDriver::start(Application application) {
   warnings_.clear();
   stopping_ = false;
   requested_ = completed_ = 0;
+  cyclicDone_ = false;
   failedCycles_ = 0;
   overruns_ = 0;
   firstError_.clear();
@@ -88,8 +89,7 @@ Status RtDriver::start(Application application) {
 
 void RtDriver::stop() {
   if (!running_.load()) return;
-  stopping_ = true;
-  handoff_.notify_all();
+  stopping_ = true;  // the cyclic task ends after its cycle, then send/receive
   for (std::thread* t : {&cyclic_, &control_, &sendReceive_}) {
     if (t->joinable()) t->join();
   }
@@ -101,8 +101,9 @@ void RtDriver::stop() {
 void RtDriver::cyclicLoop() {
   SimTime next = monotonicNow() + options_.period;
   std::uint64_t cycle = 0;
-  while (!stopping_.load()) {
+  while (true) {
     sleepUntil(next);
+    if (stopping_.load()) break;
     const SimTime woke = monotonicNow();
     ++cycle;
     {
@@ -114,7 +115,7 @@ void RtDriver::cyclicLoop() {
       std::unique_lock<std::mutex> lock(handoffLock_);
       ++requested_;
       handoff_.notify_all();
-      handoff_.wait(lock, [&] { return completed_ == requested_ || stopping_.load(); });
+      handoff_.wait(lock, [&] { return completed_ == requested_; });
     }
     next += options_.period;
     const SimTime now = monotonicNow();
@@ -123,6 +124,9 @@ void RtDriver::cyclicLoop() {
       next += ((now - next) / options_.period + 1) * options_.period;
     }
   }
+  std::lock_guard<std::mutex> lock(handoffLock_);
+  cyclicDone_ = true;
+  handoff_.notify_all();
 }
 
 void RtDriver::sendReceiveLoop() {
@@ -130,8 +134,8 @@ void RtDriver::sendReceiveLoop() {
   while (true) {
     {
       std::unique_lock<std::mutex> lock(handoffLock_);
-      handoff_.wait(lock, [&] { return requested_ > done || stopping_.load(); });
-      if (requested_ == done && stopping_.load()) return;
+      handoff_.wait(lock, [&] { return requested_ > done || cyclicDone_; });
+      if (requested_ == done) return;  // the cyclic task has ended
     }
     Status status;
     {

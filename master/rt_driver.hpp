@@ -100,6 +100,7 @@ class RtDriver {
   std::condition_variable handoff_;
   std::uint64_t requested_{0};  // cycles handed to send/receive
   std::uint64_t completed_{0};  // cycles it finished
+  bool cyclicDone_{false};      // the cyclic task has ended (no more requests)
 
   mutable std::mutex snapshotLock_;
   RtSnapshot snapshot_;
