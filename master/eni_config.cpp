@@ -67,7 +67,8 @@ char eniStateLetter(AlState state) {
   return 'I';
 }
 
-std::size_t addEniRegisterCmds(DatagramBatch& batch, const EniSlave& slave, char from, char to) {
+std::size_t addEniRegisterCmds(DatagramBatch& batch, const EniSlave& slave, char from, char to,
+                               std::vector<int>* lines) {
   constexpr std::uint16_t kAlControl = 0x0120;
   std::size_t added = 0;
   for (const EniRegisterCmd& c : slave.initCmds) {
@@ -82,6 +83,7 @@ std::size_t addEniRegisterCmds(DatagramBatch& batch, const EniSlave& slave, char
     } else {
       d.prepare(command, address, ConstBytes(c.data.data(), c.data.size()), wkc);
     }
+    if (lines != nullptr) lines->push_back(c.line);
     ++added;
   }
   return added;

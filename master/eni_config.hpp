@@ -29,8 +29,9 @@ char eniStateLetter(AlState state);
 
 // The register init commands of `slave` for the transition from -> to, as datagrams added to
 // `batch` (writes to AL control 0x0120 are left out: the master's state machine does them).
-// Returns the number added.
-std::size_t addEniRegisterCmds(DatagramBatch& batch, const EniSlave& slave, char from, char to);
+// Returns the number added; `lines` (if given) gets each added command's ENI line.
+std::size_t addEniRegisterCmds(DatagramBatch& batch, const EniSlave& slave, char from, char to,
+                               std::vector<int>* lines = nullptr);
 
 // The CoE init commands of `slave` for the transition from -> to.
 std::vector<const EniCoeCmd*> eniCoeCmds(const EniSlave& slave, char from, char to);

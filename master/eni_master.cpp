@@ -99,23 +99,23 @@ Status Master::runInitCommands(AlState target, InitPhase phase) {
   }
   // Register commands of every slave together, then CoE commands slave by slave.
   DatagramBatch batch;
-  std::vector<std::pair<std::size_t, std::size_t>> owners;  // (slave, first datagram)
+  std::vector<std::size_t> owners;  // per datagram: the slave
+  std::vector<int> lines;           // per datagram: the ENI line of its command
   for (std::size_t i = 0; i < count; ++i) {
-    owners.emplace_back(i, batch.size());
-    (void)addEniRegisterCmds(batch, eni.slaves[i], transitionFrom_[i], to);
+    const std::size_t added =
+        addEniRegisterCmds(batch, eni.slaves[i], transitionFrom_[i], to, &lines);
+    owners.insert(owners.end(), added, i);
   }
   if (!batch.empty()) {
     batch.queueAll(transport_);
     BatchWait wait(batch);
     ECSIM_TRY(run(wait, options_.state.timeout, "ENI init commands"));
-    for (std::size_t k = 0; k < owners.size(); ++k) {
-      const std::size_t end = k + 1 < owners.size() ? owners[k + 1].second : batch.size();
-      for (std::size_t d = owners[k].second; d < end; ++d) {
-        if (auto s = batch[d].check(); !s.ok()) {
-          return makeError(s.error().code, "register init command of " +
-                                               slaves_[owners[k].first].label() + " (" + file +
-                                               "): " + s.error().context);
-        }
+    for (std::size_t d = 0; d < batch.size(); ++d) {
+      if (auto s = batch[d].check(); !s.ok()) {
+        return makeError(s.error().code, "register init command of " + slaves_[owners[d]].label() +
+                                             " (" + std::string{transitionFrom_[owners[d]], to} +
+                                             "), " + file + " line " + std::to_string(lines[d]) +
+                                             ": " + s.error().context);
       }
     }
   }

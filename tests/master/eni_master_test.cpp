@@ -240,5 +240,28 @@ TEST_F(EniMasterTest, SdoAbortInACoeInitCommandNamesCommandSlaveAndLine) {
   for (std::size_t i = 0; i < 6; ++i) EXPECT_EQ(sim(i).state(), AlState::kPreOp);
 }
 
+TEST_F(EniMasterTest, RegisterInitCommandWithAnotherWorkingCounterNamesTheLine) {
+  addDemoSlaves(net_.segment());
+  build();
+  // DO1's PS watchdog write is addressed to a station nobody has: WKC 0, expected 1.
+  std::string xml = readFile(kDemoEni);
+  const std::string from = "<Adp>1003</Adp>";
+  ASSERT_NE(xml.find(from), std::string::npos);
+  xml.replace(xml.find(from), from.size(), "<Adp>3003</Adp>");
+  configure(xml, "wkc-eni.xml");
+  int line = 0;
+  for (const auto& c : master_->config()->eni->slaves[2].initCmds) {
+    if (c.transitions[0].name() == "PS") line = c.line;
+  }
+  auto status = master_->start();
+  ASSERT_FALSE(status.ok());
+  EXPECT_EQ(status.error().code, ErrorCode::kWorkingCounter);
+  const std::string& text = status.error().context;
+  EXPECT_NE(text.find("register init command of slave 2 (0x03EB '"), std::string::npos) << text;
+  EXPECT_NE(text.find("(PS), wkc-eni.xml line " + std::to_string(line) + ": "), std::string::npos)
+      << text;
+  for (std::size_t i = 0; i < 6; ++i) EXPECT_EQ(sim(i).state(), AlState::kPreOp);
+}
+
 }  // namespace
 }  // namespace ecsim::testing
