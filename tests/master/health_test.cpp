@@ -197,6 +197,30 @@ TEST_F(RecoveryTest, PowerCycledSlaveGetsItsAddressAndConfigurationBack) {
   EXPECT_EQ(run(200), 0u);
 }
 
+TEST_F(RecoveryTest, PowerOffInTheLineLosesTheRestAndPowerOnBringsAllBack) {
+  build();
+  EXPECT_EQ(run(100), 0u);
+  // AI1 loses power, as topology/faults.hpp's power-off does it: its neighbours see their
+  // links break (the drive behind it is cut off too) ...
+  net_.segment().setLinkUp(kDo, 1, false);
+  net_.segment().setLinkUp(kDrive, 0, false);
+  run(200);
+  ASSERT_NE(findEvent(MasterEventKind::kSlaveLost, kAi), nullptr) << eventLog();
+  ASSERT_NE(findEvent(MasterEventKind::kSlaveLost, kDrive), nullptr) << eventLog();
+  EXPECT_EQ(run(100), 0u);  // the rest runs clean meanwhile
+  // ... and comes back from a power-on reset: station address 0, INIT.
+  sim(kAi).esc().powerOnReset();
+  net_.segment().setLinkUp(kDo, 1, true);
+  net_.segment().setLinkUp(kDrive, 0, true);
+  const auto back = runUntil([&] { return master_->health().allOperational(); }, 3000);
+  EXPECT_LE(back, 1000u) << eventLog();
+  EXPECT_NE(findEvent(MasterEventKind::kSlaveReset, kAi), nullptr) << eventLog();
+  EXPECT_NE(findEvent(MasterEventKind::kSlaveReturned, kDrive), nullptr) << eventLog();
+  EXPECT_EQ(sim(kAi).state(), AlState::kOp);
+  EXPECT_EQ(sim(kDrive).state(), AlState::kOp);
+  EXPECT_EQ(run(200), 0u);
+}
+
 TEST_F(RecoveryTest, SafeOpWithErrorIsAcknowledgedAndBroughtBackToOp) {
   build();
   EXPECT_EQ(run(50), 0u);
