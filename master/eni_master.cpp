@@ -92,6 +92,15 @@ Status Master::runInitCommands(AlState target, InitPhase phase) {
     return s;
   }
   if (initCmdsDoneFor_ == target) return okStatus();
+  // A caller that scanned and went on without start() (tools: scan, then bringTo) has not set
+  // the ENI's station addresses yet; its init commands may (APWR 0x0010), and the master must
+  // know them first.
+  for (std::size_t i = 0; i < count; ++i) {
+    if (slaves_[i].station != eni.slaves[i].physAddr) {
+      ECSIM_TRY(applyEniSetup());
+      break;
+    }
+  }
   initCmdsDoneFor_ = target;
   transitionFrom_.assign(slaves_.size(), 'I');
   for (std::size_t i = 0; i < slaves_.size(); ++i) {

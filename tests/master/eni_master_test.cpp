@@ -263,5 +263,20 @@ TEST_F(EniMasterTest, RegisterInitCommandWithAnotherWorkingCounterNamesTheLine) 
   for (std::size_t i = 0; i < 6; ++i) EXPECT_EQ(sim(i).state(), AlState::kPreOp);
 }
 
+TEST_F(EniMasterTest, ScanThenBringToUsesTheEniStationsToo) {
+  // What the ecmaster tool does: scan (addresses 0x1001..), then bringTo(OP) without start().
+  addDemoSlaves(net_.segment());
+  build();
+  ASSERT_TRUE(master_->loadConfig(kDemoEni).ok());
+  ASSERT_TRUE(master_->scan().ok());
+  EXPECT_EQ(master_->slaves()[0].station, 0x1001);
+  auto status = master_->bringTo(AlState::kOp);
+  ASSERT_TRUE(status.ok()) << status.error().message();
+  for (std::size_t i = 0; i < 6; ++i) {
+    EXPECT_EQ(master_->slaves()[i].station, 1001 + i);
+    EXPECT_EQ(sim(i).state(), AlState::kOp);
+  }
+}
+
 }  // namespace
 }  // namespace ecsim::testing
