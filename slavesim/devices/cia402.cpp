@@ -106,7 +106,7 @@ std::uint8_t errorRegisterFor(std::uint16_t code) {
     case 0x6:
     case 0x7:
     case 0x8:
-      reg |= (code >> 8) == 0x81 ? 0x10 : 0x20;
+      reg = static_cast<std::uint8_t>(reg | ((code >> 8) == 0x81 ? 0x10 : 0x20));
       break;
     default:
       break;
