@@ -27,6 +27,8 @@ std::size_t Segment::addSlave(std::unique_ptr<slavesim::Slave> slave) {
   observers_.push_back({});
   stack_.reserve(slaves_.size() + 1);
   escs_.push_back(&slaves_.back()->esc());
+  routeArrival_.push_back({});
+  routeValid_ = false;
   latched_.reserve(slaves_.size());
   refreshLinkStatus();
   return slaves_.size() - 1;
@@ -61,6 +63,7 @@ Status Segment::connect(std::size_t a, unsigned pa, std::size_t b, unsigned pb, 
   links_[a][pa] = {static_cast<int>(b), static_cast<std::uint8_t>(pb), metres};
   links_[b][pb] = {static_cast<int>(a), static_cast<std::uint8_t>(pa), metres};
   cableNs_[a][pa] = cableNs_[b][pb] = cableDelay(metres);
+  routeValid_ = false;
   refreshLinkStatus();
   return okStatus();
 }
@@ -72,6 +75,7 @@ void Segment::wireLine(double metres) {
 }
 
 void Segment::updateCableDelays() {
+  routeValid_ = false;
   for (std::size_t i = 0; i < slaves_.size(); ++i) {
     for (unsigned p = 0; p < kPortCount; ++p) cableNs_[i][p] = cableDelay(links_[i][p].cableMetres);
   }
@@ -88,6 +92,7 @@ void Segment::setCableObserver(std::size_t slave, unsigned port, CableObserver* 
 
 void Segment::setDelays(std::size_t slave, SimTime processing, SimTime forwarding) {
   delays_[slave] = {processing, forwarding};
+  routeValid_ = false;
 }
 
 bool Segment::portOpen(std::size_t s, unsigned p) const {
@@ -102,10 +107,12 @@ void Segment::setLinkUp(std::size_t s, unsigned p, bool up) {
   if (s >= slaves_.size() || p >= kPortCount) return;
   if (linkUp_[s][p] && !up) slaves_[s]->esc().countLostLink(p);
   linkUp_[s][p] = up;
+  routeValid_ = false;
   refreshLinkStatus();
 }
 
 void Segment::refreshLinkStatus() {
+  routeValid_ = false;  // port states may have changed
   for (std::size_t s = 0; s < slaves_.size(); ++s) {
     auto& esc = slaves_[s]->esc();
     std::uint16_t dl = static_cast<std::uint16_t>(esc.reg16(reg::kDlStatus.address) & 0x000F);
@@ -153,8 +160,33 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
   counters_.datagramsProcessed += count;
   frame[6] |= 0x02;  // an ESC sets the locally administered bit of the source MAC (§3)
 
-  stack_.clear();
   latched_.clear();
+  const SimTime frameTime =
+      static_cast<SimTime>(8 + std::max<std::size_t>(frame.size(), kMinFrameSize) + 4) * nsPerByte;
+  if (routeValid_ && faults_ == nullptr && !anyObserver_) {
+    // The wiring, port states and delays have not changed since the route was recorded: the
+    // frame reaches the same ESCs in the same order at the same times relative to sendTime.
+    for (const RouteStop& stop : route_) {
+      slavesim::Esc& esc = *escs_[stop.slave];
+      esc.beginFrame();
+      const SimTime t = sendTime + stop.at;
+      for (std::size_t i = 0; i < count; ++i) esc.processDatagram(datagrams_[i], t + leads[i]);
+      if (esc.receiveTimeLatchArmed()) latched_.push_back(stop.slave);
+    }
+    for (const std::uint32_t i : latched_) {
+      std::array<SimTime, kPortCount> at = routeArrival_[i];
+      for (auto& a : at) a += sendTime;
+      escs_[i]->completeReceiveTimeLatch(at, routeMask_[i]);
+    }
+    outcome.firstBitRoundTrip = routeRoundTrip_;
+    outcome.delivered = true;
+    outcome.returnTime = sendTime + outcome.firstBitRoundTrip + frameTime;
+    return outcome;
+  }
+  // The walk, recording the route for the frames that follow (not with faults: they may delay).
+  const bool record = faults_ == nullptr;
+  route_.clear();
+  stack_.clear();
   for (auto& m : arrivalMask_) m = 0;
   std::uint32_t s = 0;
   std::uint8_t k = 0;
@@ -173,6 +205,7 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
     if (k == 0) {
       slavesim::Esc& esc = *escs_[s];
       esc.beginFrame();
+      if (record) route_.push_back({s, t - sendTime});
       for (std::size_t i = 0; i < (bad ? 0 : count); ++i) {
         esc.processDatagram(datagrams_[i], t + leads[i]);
       }
@@ -220,10 +253,16 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
   for (const std::uint32_t i : latched_) {
     escs_[i]->completeReceiveTimeLatch(arrival_[i], arrivalMask_[i]);
   }
+  if (record) {
+    for (std::size_t i = 0; i < slaves_.size(); ++i) {
+      for (unsigned p = 0; p < kPortCount; ++p) routeArrival_[i][p] = arrival_[i][p] - sendTime;
+    }
+    routeMask_ = arrivalMask_;
+    routeRoundTrip_ = outcome.firstBitRoundTrip;
+    routeValid_ = true;
+  }
   // The master has the frame when its last bit is in: wire footprint of the frame itself
   // (preamble + SFD + frame + FCS).
-  const SimTime frameTime =
-      static_cast<SimTime>(8 + std::max<std::size_t>(frame.size(), kMinFrameSize) + 4) * nsPerByte;
   outcome.delivered = !bad;
   outcome.returnTime = sendTime + outcome.firstBitRoundTrip + frameTime;
   return outcome;

@@ -83,7 +83,10 @@ class Segment {
   Status connect(std::size_t a, unsigned pa, std::size_t b, unsigned pb, double metres = 1.0);
   // Wires slaves 0..n-1 as a line (port 1 of each to port 0 of the next).
   void wireLine(double metres = 1.0);
-  void setMasterCable(double metres) { masterCable_ = metres; }
+  void setMasterCable(double metres) {
+    masterCable_ = metres;
+    routeValid_ = false;
+  }
   // Observes the cable at `slave`'s port `port` (both directions); nullptr removes it. The
   // cable between the master and slave 0 is (0, 0).
   void setCableObserver(std::size_t slave, unsigned port, CableObserver* observer);
@@ -162,6 +165,18 @@ class Segment {
   std::vector<Visit> stack_;
   std::vector<slavesim::Esc*> escs_;    // slaves_[i]->esc(), one indirection less per visit
   std::vector<std::uint32_t> latched_;  // slaves whose receive-time latch this frame armed
+  // The path of the last frame without faults, relative to its send time: the ESCs in the
+  // order the frame passed their processing units, the first bit's arrival at every port, the
+  // first-bit round trip. Valid until the wiring, a port, a delay or the timing changes.
+  struct RouteStop {
+    std::uint32_t slave;
+    SimTime at;  // arrival at port 0
+  };
+  std::vector<RouteStop> route_;
+  std::vector<std::array<SimTime, kPortCount>> routeArrival_;
+  std::vector<std::uint8_t> routeMask_;
+  SimTime routeRoundTrip_{0};
+  bool routeValid_{false};
 };
 
 }  // namespace ecsim::topology
