@@ -30,6 +30,18 @@ std::string readText(const std::string& path) {
   return t;
 }
 
+// The lines of text matching pattern (for failure messages).
+std::string lines(const std::string& text, const std::string& pattern) {
+  std::regex re(pattern);
+  std::istringstream in(text);
+  std::string line;
+  std::string out;
+  while (std::getline(in, line)) {
+    if (std::regex_search(line, re)) out += line + "\n";
+  }
+  return out;
+}
+
 int countMatches(const std::string& text, const std::string& pattern) {
   std::regex re(pattern);
   return static_cast<int>(
@@ -67,7 +79,17 @@ class SoemRun {
     auto server = ns->spawn(serve, SpawnOptions{serveLog_, serveLog_});
     EXPECT_TRUE(server.ok());
     if (!server.ok()) return {};
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // socket open
+    // Ready once it says it serves (the socket is open then); a fixed sleep raced with a
+    // slow start on a busy host ("No slaves found!").
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+    while (readText(serveLog_).find("ecsim: serving") == std::string::npos && server->running() &&
+           std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    EXPECT_NE(readText(serveLog_).find("ecsim: serving"), std::string::npos)
+        << "ecsim serve did not start:\n"
+        << readText(serveLog_);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
     std::vector<std::string> argv{(kSoem / program).string(), ns->masterInterface()};
     argv.insert(argv.end(), args.begin(), args.end());
     std::vector<std::string> timed{"timeout", std::to_string(timeout.count())};
@@ -224,10 +246,18 @@ TEST(SoemV2, SimpleNgReportsAllSlavesOperational) {
   std::string out = run.run("bin-v2/simple_ng", {}, std::chrono::seconds(120));
   EXPECT_NE(out.find("6 slaves found"), std::string::npos) << out.substr(0, 2000);
   EXPECT_NE(out.find("all slaves are now operational"), std::string::npos) << out.substr(0, 2000);
-  EXPECT_EQ(countMatches(out, "\\* Slave [0-9]+ (lost|is in SAFE_OP)"), 0);
+  // No slave ever leaves OP (a watchdog or AL error would show as SAFE_OP here).
+  EXPECT_EQ(countMatches(out, "\\* Slave [0-9]+ is in SAFE_OP"), 0)
+      << lines(out, "Slave|AL|WARNING|ERROR|wrong");
   // simple_ng waits 2 ms for each answer; a host too busy to schedule the simulator in time
-  // shows as an occasional "wrong" iteration, which is the host's, not the network's.
-  EXPECT_LE(countMatches(out, "wrong \\(expected"), 10) << out.substr(0, 4000);
+  // shows as an occasional "wrong" iteration, which is the host's, not the network's. Its
+  // state check right after may time out as well and print "Slave N lost" (seen once in CI:
+  // iteration 9326 took 4 ms, the next ones had WKC 10 again), so a "lost" is tolerated
+  // only as the echo of a wrong iteration.
+  const int wrong = countMatches(out, "wrong \\(expected");
+  EXPECT_LE(wrong, 10) << out.substr(0, 4000);
+  EXPECT_LE(countMatches(out, "\\* Slave [0-9]+ lost"), wrong)
+      << lines(out, "Slave|AL|WARNING|ERROR|wrong");
   EXPECT_GE(
       countMatches(out, "Iteration +[0-9]+: +[0-9]+ usec +WKC " + std::to_string(kDemoWkc) + " "),
       9900);
