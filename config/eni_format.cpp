@@ -3,32 +3,12 @@
 #include <cstdio>
 
 #include "config/eni.hpp"
+#include "config/xml_util.hpp"
 
 namespace ecsim {
 namespace {
 
-std::string escape(std::string_view text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
+using xml::escapeText;
 
 std::string hex(std::uint32_t value, int digits) {
   char buf[16];
@@ -57,7 +37,7 @@ class Writer {
     line("</" + std::string(tag) + ">");
   }
   void leaf(std::string_view tag, const std::string& value) {
-    line("<" + std::string(tag) + ">" + escape(value) + "</" + std::string(tag) + ">");
+    line("<" + std::string(tag) + ">" + escapeText(value) + "</" + std::string(tag) + ">");
   }
   void leaf(std::string_view tag, std::uint64_t value) { leaf(tag, std::to_string(value)); }
   void line(const std::string& text) {
@@ -105,8 +85,9 @@ void pdo(Writer& w, const char* tag, const EniPdo& p) {
   w.leaf("Name", p.name);
   for (const auto& e : p.entries) {
     w.line("<Entry><Index>" + hex(e.index, 4) + "</Index><SubIndex>" + std::to_string(e.subIndex) +
-           "</SubIndex><BitLen>" + std::to_string(e.bitLen) + "</BitLen><Name>" + escape(e.name) +
-           "</Name><DataType>" + escape(e.dataType) + "</DataType></Entry>");
+           "</SubIndex><BitLen>" + std::to_string(e.bitLen) + "</BitLen><Name>" +
+           escapeText(e.name) + "</Name><DataType>" + escapeText(e.dataType) +
+           "</DataType></Entry>");
   }
   w.close(tag);
 }
@@ -199,7 +180,7 @@ void variables(Writer& w, const char* tag, std::optional<std::uint32_t> byteSize
   w.open(tag);
   if (byteSize) w.leaf("ByteSize", *byteSize);
   for (const auto& v : list) {
-    w.line("<Variable><Name>" + escape(v.name) + "</Name><DataType>" + escape(v.dataType) +
+    w.line("<Variable><Name>" + escapeText(v.name) + "</Name><DataType>" + escapeText(v.dataType) +
            "</DataType><BitSize>" + std::to_string(v.bitSize) + "</BitSize><BitOffs>" +
            std::to_string(v.bitOffs) + "</BitOffs></Variable>");
   }

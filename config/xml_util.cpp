@@ -42,6 +42,30 @@ std::size_t entityReferenceLength(std::string_view s, std::size_t at) {
 
 }  // namespace
 
+std::string escapeText(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (char c : text) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
 std::string_view text(const Element* e) {
   if (e == nullptr) return {};
   const char* t = e->GetText();

@@ -1,6 +1,6 @@
 // Small helpers over tinyxml2 shared by the config readers: errors that name file and line,
 // typed text/attribute access in ESI number syntax, and the well-formedness checks tinyxml2
-// leaves out. Internal to config/.
+// leaves out. Internal to config/ (escapeText is also used by the scenario JUnit writer).
 #pragma once
 
 #include <tinyxml2.h>
@@ -19,6 +19,9 @@
 namespace ecsim::xml {
 
 using Element = tinyxml2::XMLElement;
+
+// Text or attribute value with &, <, > and " written as entities.
+std::string escapeText(std::string_view text);
 
 // Iterates the child elements named `name` (all children when name is null).
 class Children {

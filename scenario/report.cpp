@@ -2,6 +2,7 @@
 // the same bytes.
 #include <fmt/core.h>
 
+#include "config/xml_util.hpp"
 #include "scenario/runner.hpp"
 
 namespace ecsim::scenario {
@@ -23,27 +24,7 @@ std::string valueText(double v) {
 }
 
 std::string xmlEscape(std::string_view text) {
-  std::string out;
-  out.reserve(text.size());
-  for (char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
+  return xml::escapeText(text);
 }
 
 }  // namespace
