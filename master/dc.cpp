@@ -4,21 +4,22 @@
 #include <cstdlib>
 
 #include "master/master.hpp"
+#include "protocol/registers.hpp"
 
 namespace ecsim::master {
 namespace {
 
-constexpr std::uint16_t kPortTimes = 0x0900;
-constexpr std::uint16_t kSystemTime = 0x0910;
-constexpr std::uint16_t kEpuTime = 0x0918;
-constexpr std::uint16_t kOffset = 0x0920;
-constexpr std::uint16_t kDelay = 0x0928;
-constexpr std::uint16_t kDifference = 0x092C;
-constexpr std::uint16_t kSpeedCounterStart = 0x0930;
-constexpr std::uint16_t kAssign = 0x0980;
-constexpr std::uint16_t kActivation = 0x0981;
-constexpr std::uint16_t kSync0Start = 0x0990;
-constexpr std::uint16_t kSync0CycleTime = 0x09A0;
+constexpr std::uint16_t kPortTimes = reg::kReceiveTimePort0.address;
+constexpr std::uint16_t kSystemTime = reg::kSystemTime.address;
+constexpr std::uint16_t kEpuTime = reg::kReceiveTimeEcatProcessingUnit.address;
+constexpr std::uint16_t kOffset = reg::kSystemTimeOffset.address;
+constexpr std::uint16_t kDelay = reg::kSystemTimeDelay.address;
+constexpr std::uint16_t kDifference = reg::kSystemTimeDifference.address;
+constexpr std::uint16_t kSpeedCounterStart = reg::kSpeedCounterStart.address;
+constexpr std::uint16_t kAssign = reg::kCyclicUnitControl.address;
+constexpr std::uint16_t kActivation = reg::kDcActivation.address;
+constexpr std::uint16_t kSync0Start = reg::kStartTimeCyclicOperation.address;
+constexpr std::uint16_t kSync0CycleTime = reg::kSync0CycleTime.address;
 constexpr std::array<unsigned, 4> kPortOrder{0, 3, 1, 2};
 
 bool portOpen(const SlaveInfo& s, unsigned port) {

@@ -31,8 +31,8 @@ constexpr std::uint8_t kActivationSync0 = 0x02;
 constexpr std::uint8_t kActivationSync1 = 0x04;
 constexpr std::uint8_t kActivationStatusSync0Pending = 0x01;
 constexpr std::uint8_t kActivationStatusSync1Pending = 0x02;
-constexpr std::uint16_t kSync0StatusAddress = 0x098E;
-constexpr std::uint16_t kSync1StatusAddress = 0x098F;
+constexpr std::uint16_t kSync0StatusAddress = reg::kSync0Status.address;
+constexpr std::uint16_t kSync1StatusAddress = reg::kSync1Status.address;
 
 // Wrap-aware "a is not after b" for 64-bit system times.
 bool notAfter(std::uint64_t a, std::uint64_t b) {

@@ -54,6 +54,15 @@ Result<std::int64_t> parseSigned(std::string_view text) {
   return static_cast<std::int64_t>(magnitude);
 }
 
+// A value of a fixed-size type needs at least that many bytes.
+Status checkLength(std::size_t size, ConstBytes bytes) {
+  if (size != 0 && bytes.size() < size) {
+    return makeError(ErrorCode::kTruncated,
+                     fmt::format("{} bytes where the type needs {}", bytes.size(), size));
+  }
+  return {};
+}
+
 }  // namespace
 
 Result<ValueType> parseValueType(std::string_view name) {
@@ -183,10 +192,7 @@ std::string hexBytes(ConstBytes bytes) {
 
 Result<std::string> formatValue(ValueType type, ConstBytes bytes) {
   const std::size_t size = valueSize(type);
-  if (size != 0 && bytes.size() < size) {
-    return makeError(ErrorCode::kTruncated,
-                     fmt::format("{} bytes where the type needs {}", bytes.size(), size));
-  }
+  ECSIM_TRY(checkLength(size, bytes));
   switch (type) {
     case ValueType::kRaw:
     case ValueType::kOctets:
@@ -211,10 +217,7 @@ Result<std::string> formatValue(ValueType type, ConstBytes bytes) {
 
 Result<nlohmann::json> jsonValue(ValueType type, ConstBytes bytes) {
   const std::size_t size = valueSize(type);
-  if (size != 0 && bytes.size() < size) {
-    return makeError(ErrorCode::kTruncated,
-                     fmt::format("{} bytes where the type needs {}", bytes.size(), size));
-  }
+  ECSIM_TRY(checkLength(size, bytes));
   switch (type) {
     case ValueType::kRaw:
     case ValueType::kOctets:
