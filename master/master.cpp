@@ -298,22 +298,29 @@ Status Master::readData(std::size_t offset, Bytes out) const {
   return okStatus();
 }
 
-Status Master::sendCycle() {
+Status Master::sendCycle(SimTime now) {
   if (!cyclic_.built()) {
     return makeError(ErrorCode::kState, "no process data configured (start() first)");
   }
-  return cyclic_.send(transport_, image_, bus_.now());
+  return cyclic_.send(transport_, image_, now);
 }
 
-CycleResult Master::finishCycle() {
-  return cyclic_.finish(image_);
+bool Master::pollCycle(SimTime now) {
+  transport_.poll(now);
+  return cyclic_.pending();
 }
 
 Status Master::exchange() {
-  ECSIM_TRY(sendCycle());
+  failedSinceControl_.reset();  // the blocking path: control() looks at this cycle only
+  ECSIM_TRY(sendCycle(bus_.now()));
   CycleWait wait(cyclic_);
   ECSIM_TRY(run(wait, 4 * options_.transport.timeout, "cycle"));
-  lastCycle_ = finishCycle();
+  return finishCycle();
+}
+
+Status Master::finishCycle() {
+  lastCycle_ = cyclic_.finish(image_);
+  if (!lastCycle_.ok() && !failedSinceControl_) failedSinceControl_ = lastCycle_;
   if (lastCycle_.framesLost > 0) {
     return makeError(ErrorCode::kTimeout,
                      std::to_string(lastCycle_.framesLost) + " cyclic frame(s) lost");
@@ -400,8 +407,14 @@ Status Master::writeRegisters(std::size_t position, std::uint16_t address, Const
 
 Status Master::cycle() {
   Status status = exchange();
-  if (health_) health_->afterCycle(lastCycle_, cyclic_.statistics().cycles, bus_.now());
+  control(bus_.now());
   return status;
+}
+
+void Master::control(SimTime now) {
+  const CycleResult& seen = failedSinceControl_ ? *failedSinceControl_ : lastCycle_;
+  if (health_) health_->afterCycle(seen, cyclic_.statistics().cycles, now);
+  failedSinceControl_.reset();
 }
 
 const std::vector<MasterEvent>& Master::events() const {

@@ -91,6 +91,26 @@ class Master {
   //
   //   while (running) { master.cycle(); for (auto& e : master.events()) log(e.text); ... }
   Status cycle();
+  // cycle() in steps, for a driver that runs them on different threads (master/rt_driver.hpp):
+  //
+  //   sendCycle(now)     the cached frames out with the outputs of the process image; datagrams
+  //                      queued meanwhile (status reads, recovery, acyclic tasks) go out with
+  //                      them, at the first pollCycle()
+  //   pollCycle(now)     receives what has arrived, handles timeouts, sends what is queued;
+  //                      true while a frame of this cycle is in flight (call it again after
+  //                      the Bus waited)
+  //   finishCycle()      inputs into the image, WKCs checked: exchange()'s status
+  //   control(now)       the HealthMonitor after the cycle: status reads, one recovery step
+  //
+  // cycle() is exactly these four in a row, with the Bus waiting between the polls. None of
+  // them blocks or allocates while nothing goes wrong, and none is thread-safe: a caller on
+  // several threads runs each step under one lock that also guards the process image (the
+  // driver's master lock) and waits for frames outside it. When control() runs less often than
+  // the cycles, it looks at the first failed cycle since it last ran, else the last one.
+  Status sendCycle(SimTime now);
+  bool pollCycle(SimTime now);
+  Status finishCycle();
+  void control(SimTime now);
   // Lost / returned / reset / error / recovered / recovery failed, oldest first, each naming
   // the slave and the cycle ("slave 3 (0x1004 'DO1') lost at cycle 1002").
   const std::vector<MasterEvent>& events() const;
@@ -156,8 +176,6 @@ class Master {
  private:
   Status run(Task& task, SimTime timeout, std::string_view what);
   Result<SlaveInfo*> slaveAt(std::size_t position);
-  Status sendCycle();
-  CycleResult finishCycle();
   // ENI configuration (master/eni_master.cpp): station addresses and mailbox areas after the
   // scan; init commands of each slave's transition to `target`: register and CoE commands
   // before the request (phase kBefore), CoE commands of IP once PREOP is reached (kAfter).
@@ -175,6 +193,7 @@ class Master {
   std::vector<std::uint8_t> image_;
   CyclicExchange cyclic_;
   CycleResult lastCycle_;
+  std::optional<CycleResult> failedSinceControl_;  // the first failed cycle control() has not seen
   std::vector<StateRefusal> refusals_;
   std::vector<ReceivedEmergency> emergencies_;
   std::unique_ptr<HealthMonitor> health_;  // made with the process image
