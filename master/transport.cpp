@@ -220,7 +220,8 @@ void Transport::release(Slot& slot, DatagramState datagramState) {
     slot.cached = nullptr;
   }
   slot.datagramCount = 0;
-  indexState_[slot.index] = IndexState::kClosed;
+  indexState_[slot.index] =
+      datagramState == DatagramState::kTimedOut ? IndexState::kGivenUp : IndexState::kClosed;
   indexSlot_[slot.index] = -1;
   slot.busy = false;
   --inFlight_;
@@ -281,7 +282,12 @@ void Transport::handleFrame(std::size_t length, SimTime now) {
   }
   const std::uint8_t index = (*answer->begin()).index();
   if (indexState_[index] != IndexState::kInFlight) {
-    if (indexState_[index] == IndexState::kClosed) {
+    if (indexState_[index] == IndexState::kGivenUp) {
+      // It was not lost after all: the network returned it, after we had stopped waiting.
+      --counters_.framesLost;
+      ++counters_.framesLate;
+      indexState_[index] = IndexState::kClosed;
+    } else if (indexState_[index] == IndexState::kClosed) {
       ++counters_.framesLate;
     } else {
       ++counters_.framesUnexpected;

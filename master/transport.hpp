@@ -9,8 +9,10 @@
 //    lengths) before its data and WKC are copied back into the datagrams;
 //  - a frame unanswered after `timeout` is sent again with the same index (as SOEM and IgH
 //    do), `retries` times; then its datagrams become kTimedOut and the frame counts as lost;
-//  - an answer to a frame already answered or given up counts as late; a frame that matches
-//    nothing of ours (unknown index, other content, not EtherCAT) as unexpected.
+//  - an answer to a frame already answered or given up counts as late; a frame given up whose
+//    answer still arrives (before its index is used again) moves from lost to late: lost means
+//    the network never returned it, late that it came back after we stopped waiting. A frame
+//    that matches nothing of ours (unknown index, other content, not EtherCAT) is unexpected.
 //
 // CachedFrame is the cyclic path: a frame built once by its owner, sent as it is each cycle
 // (only its index bytes are rewritten), answered into the frame's own receive buffer. It is
@@ -47,7 +49,8 @@ struct TransportCounters {
   std::uint64_t framesResent{0};      // retries with the same index
   std::uint64_t framesReceived{0};    // every frame the link delivered to us
   std::uint64_t framesAnswered{0};    // matched to a frame in flight
-  std::uint64_t framesLost{0};        // given up after every try, or abandoned (cyclic)
+  std::uint64_t framesLost{0};        // given up after every try, or abandoned (cyclic), and no
+                                      // answer since
   std::uint64_t framesLate{0};        // an answer to a frame already answered or given up
   std::uint64_t framesUnexpected{0};  // not one of ours (index unknown, content differs, ...)
   std::uint64_t datagramsSent{0};
@@ -145,7 +148,7 @@ class Transport {
 
  private:
   friend class CachedFrame;
-  enum class IndexState : std::uint8_t { kUnused, kInFlight, kClosed };
+  enum class IndexState : std::uint8_t { kUnused, kInFlight, kClosed, kGivenUp };
   struct Slot {
     bool busy{false};
     std::uint8_t index{0};
