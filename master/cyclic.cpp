@@ -7,11 +7,21 @@
 namespace ecsim::master {
 
 std::string WkcMismatch::describe(const std::vector<SlaveInfo>& slaveInfos) const {
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "LRW 0x%08X+%u: working counter %u, expected %u", logicalStart,
-                static_cast<unsigned>(length), static_cast<unsigned>(actual),
-                static_cast<unsigned>(expected));
+  char buf[128];
+  const std::string name(toString(command));
+  if (isLogical(command)) {
+    std::snprintf(buf, sizeof buf, "%s 0x%08X+%u", name.c_str(), logicalStart,
+                  static_cast<unsigned>(length));
+  } else {
+    std::snprintf(buf, sizeof buf, "%s 0x%04X:0x%04X+%u", name.c_str(),
+                  static_cast<unsigned>(logicalStart & 0xFFFFu),
+                  static_cast<unsigned>(logicalStart >> 16), static_cast<unsigned>(length));
+  }
   std::string s = buf;
+  if (line > 0) s += " (ENI line " + std::to_string(line) + ")";
+  std::snprintf(buf, sizeof buf, ": working counter %u, expected %u", static_cast<unsigned>(actual),
+                static_cast<unsigned>(expected));
+  s += buf;
   s += "; slaves concerned: ";
   for (std::size_t i = 0; i < slaves.size(); ++i) {
     if (i > 0) s += ", ";
@@ -23,43 +33,84 @@ std::string WkcMismatch::describe(const std::vector<SlaveInfo>& slaveInfos) cons
 
 Status CyclicExchange::build(const ProcessImageLayout& layout, const MacAddress& source) {
   layout_ = nullptr;
-  frames_.clear();
-  datagrams_.clear();
-  outputs_.clear();
-  inputs_.clear();
-  expectedMin_.clear();
-  expectedMax_.clear();
   statistics_ = {};
   lastSend_.reset();
+  source_ = source;
+  layout_ = &layout;
+  auto status = assemble();
+  if (!status.ok()) {
+    layout_ = nullptr;
+    frames_.clear();
+    return status;
+  }
+  resetExpectedWkcs();
+  return okStatus();
+}
+
+Status CyclicExchange::setState(AlState state) {
+  const std::optional<AlState> before = state_;
+  state_ = state;
+  if (layout_ == nullptr) return okStatus();
+  bool changed = false;
+  for (std::size_t i = 0; i < layout_->datagrams.size(); ++i) {
+    if (isActive(layout_->datagrams[i]) != datagrams_[i].active) changed = true;
+  }
+  if (!changed) return okStatus();
+  if (pending()) {
+    state_ = before;
+    return makeError(ErrorCode::kState, "cyclic frames in flight: cannot change their datagrams");
+  }
+  return assemble();
+}
+
+Status CyclicExchange::assemble() {
+  const ProcessImageLayout& layout = *layout_;
+  frames_.clear();
+  datagrams_.assign(layout.datagrams.size(), DatagramRef{});
+  outputs_.clear();
+  inputs_.clear();
   dcDatagram_.reset();
   EthernetHeader ethernet;
   ethernet.destination = kBroadcastMac;
-  ethernet.source = source;
+  ethernet.source = source_;
   for (std::size_t f = 0; f < layout.frameCount; ++f) {
     auto frame = std::make_unique<CachedFrame>();
     FrameBuilder builder(frame->buildBuffer(), ethernet);
     std::size_t k = 0;
-    for (const auto& d : layout.datagrams) {
+    for (std::size_t i = 0; i < layout.datagrams.size(); ++i) {
+      const LogicalDatagram& d = layout.datagrams[i];
       if (d.frame != f) continue;
-      auto view = builder.add(Command::kLrw, 0, d.logicalStart, d.length);
+      if (!isActive(d)) {
+        datagrams_[i].active = false;
+        continue;
+      }
+      auto view = builder.add(d.command, 0, d.logicalStart, d.length);
       if (!view.ok()) return view.takeError();
-      datagrams_.push_back({f, k++});
+      datagrams_[i] = {frames_.size(), k++, true};
+      const bool systemTime = (d.command == Command::kFrmw || d.command == Command::kArmw) &&
+                              (d.logicalStart >> 16) == reg::kSystemTime.address;
+      if (systemTime && !dcDatagram_) dcDatagram_ = datagrams_[i];
     }
-    if (f == 0 && dcReference_) {
-      auto view = builder.add(Command::kFrmw, 0, DatagramHeader::physical(*dcReference_, 0x0910),
+    if (frames_.empty() && dcReference_ && !dcDatagram_) {
+      auto view = builder.add(Command::kFrmw, 0,
+                              DatagramHeader::physical(*dcReference_, reg::kSystemTime.address),
                               std::uint16_t{8});
       if (!view.ok()) return view.takeError();
-      dcDatagram_ = k++;
+      dcDatagram_ = DatagramRef{0, k++, true};
     }
+    if (k == 0) continue;  // nothing of this frame is sent in this state
     auto length = builder.finish();
     if (!length.ok()) return length.takeError();
     ECSIM_TRY(frame->commit(*length));
     frames_.push_back(std::move(frame));
   }
-  // Copies: the part of each datagram over outputs (image -> frame) and over inputs.
+  // Copies: the part of each logical datagram over outputs (image -> frame: LWR, LRW) and over
+  // inputs (frame -> image: LRD, LRW).
   for (std::size_t i = 0; i < layout.datagrams.size(); ++i) {
     const LogicalDatagram& d = layout.datagrams[i];
     const DatagramRef& ref = datagrams_[i];
+    if (!ref.active || !isLogical(d.command)) continue;
+    const CommandAccess access = commandAccess(d.command);
     const std::uint32_t start = d.logicalStart - layout.logicalBase;
     const std::uint32_t end = start + d.length;
     const std::size_t dataOffset =
@@ -69,11 +120,9 @@ Status CyclicExchange::build(const ProcessImageLayout& layout, const MacAddress&
       const std::uint32_t b = std::min(end, to);
       if (a < b) list.push_back({ref.frame, dataOffset + (a - start), a, b - a});
     };
-    add(outputs_, 0, layout.outputBytes);
-    add(inputs_, layout.outputBytes, layout.size());
+    if (access.write) add(outputs_, 0, layout.outputBytes);
+    if (access.read) add(inputs_, layout.outputBytes, layout.size());
   }
-  layout_ = &layout;
-  resetExpectedWkcs();
   return okStatus();
 }
 
@@ -82,13 +131,13 @@ void CyclicExchange::resetExpectedWkcs() {
   expectedMax_.clear();
   if (layout_ == nullptr) return;
   for (const auto& d : layout_->datagrams) {
-    expectedMin_.push_back(d.expectedWkc);
-    expectedMax_.push_back(d.expectedWkc);
+    expectedMin_.push_back(d.checkWkc ? d.expectedWkc : std::uint16_t{0});
+    expectedMax_.push_back(d.checkWkc ? d.expectedWkc : std::uint16_t{0xFFFF});
   }
 }
 
 std::optional<std::uint16_t> CyclicExchange::receivedWkc(std::size_t datagram) const {
-  if (datagram >= datagrams_.size()) return std::nullopt;
+  if (datagram >= datagrams_.size() || !datagrams_[datagram].active) return std::nullopt;
   const CachedFrame& frame = *frames_[datagrams_[datagram].frame];
   if (frame.state() != DatagramState::kReceived) return std::nullopt;
   return frame.rxWkc(datagrams_[datagram].index);
@@ -127,11 +176,12 @@ bool CyclicExchange::pending() const {
 }
 
 std::optional<std::uint64_t> CyclicExchange::dcSystemTime() const {
-  if (!dcDatagram_ || frames_.empty() || frames_[0]->state() != DatagramState::kReceived) {
-    return std::nullopt;
-  }
-  const std::size_t at = frames_[0]->datagramOffset(*dcDatagram_) + kDatagramHeaderSize;
-  return readLe64(frames_[0]->rx(), at);
+  if (!dcDatagram_ || dcDatagram_->frame >= frames_.size()) return std::nullopt;
+  const CachedFrame& frame = *frames_[dcDatagram_->frame];
+  if (frame.state() != DatagramState::kReceived) return std::nullopt;
+  const std::size_t at = frame.datagramOffset(dcDatagram_->index) + kDatagramHeaderSize;
+  if (frame.rxData(dcDatagram_->index).size() < 8) return readLe32(frame.rx(), at);
+  return readLe64(frame.rx(), at);
 }
 
 CycleResult CyclicExchange::finish(Bytes image) {
@@ -160,6 +210,7 @@ CycleResult CyclicExchange::finish(Bytes image) {
     std::memcpy(image.data() + c.imageOffset, frame.rx().data() + c.frameOffset, c.length);
   }
   for (std::size_t i = 0; i < datagrams_.size(); ++i) {
+    if (!datagrams_[i].active) continue;
     const CachedFrame& frame = *frames_[datagrams_[i].frame];
     if (frame.state() != DatagramState::kReceived) continue;
     const std::uint16_t wkc = frame.rxWkc(datagrams_[i].index);
@@ -167,9 +218,14 @@ CycleResult CyclicExchange::finish(Bytes image) {
     if (wkc >= expectedMin_[i] && wkc <= expectedMax_[i]) continue;
     ++result.wkcErrors;
     if (!result.firstMismatch) {
-      result.firstMismatch = WkcMismatch{i,        d.logicalStart,
-                                         d.length, expectedMin_[i],
-                                         wkc,      std::span<const std::size_t>(d.slaves)};
+      result.firstMismatch = WkcMismatch{i,
+                                         d.command,
+                                         d.logicalStart,
+                                         d.length,
+                                         expectedMin_[i],
+                                         wkc,
+                                         std::span<const std::size_t>(d.slaves),
+                                         d.line};
     }
   }
   statistics_.framesLost += result.framesLost;

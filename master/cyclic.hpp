@@ -1,5 +1,6 @@
-// Cyclic process-data exchange from cached frames. build() makes the LRW frames of a layout
-// once (allocating); afterwards a cycle is
+// Cyclic process-data exchange from cached frames. build() makes the frames of a layout once
+// (allocating): its datagrams (LRWs planned by the master, or an ENI's cyclic Cmds of any
+// command) that are active in the bus state set by setState(); afterwards a cycle is
 //
 //   send(image)     abandon any frame of the last cycle still unanswered (it counts as lost),
 //                   copy the output bytes of the image into the frames, send each under a
@@ -9,7 +10,8 @@
 //                   datagram's WKC with its expected value; a mismatch names the datagram and
 //                   the slaves it touches (a view into the layout: nothing is allocated)
 //
-// Neither send() nor finish() allocates.
+// Neither send() nor finish() allocates. setState() rebuilds the frames (allocating) when the
+// set of datagrams active in the new state differs.
 #pragma once
 
 #include <cstdint>
@@ -27,12 +29,16 @@ namespace ecsim::master {
 
 struct WkcMismatch {
   std::size_t datagram{0};  // index into the layout's datagrams
-  std::uint32_t logicalStart{0};
+  Command command{Command::kLrw};
+  std::uint32_t logicalStart{0};  // the address field (LogicalDatagram::logicalStart)
   std::uint16_t length{0};
   std::uint16_t expected{0};
   std::uint16_t actual{0};
   std::span<const std::size_t> slaves;  // positions of the slaves the datagram touches
-  // "LRW 0x00000000+16: working counter 4, expected 6; slaves 0 (0x1001 'A'), 2 (...)"
+  int line{0};                          // the ENI line of its Cmd (0: planned by the master)
+  // "LRW 0x00000000+16: working counter 4, expected 6; slaves 0 (0x1001 'A'), 2 (...)";
+  // "BRD 0x0000:0x0130+2: ..." for a physical or broadcast address (ADP:ADO); an ENI Cmd adds
+  // "(ENI line N)" after the address.
   std::string describe(const std::vector<SlaveInfo>& slaveInfos) const;
 };
 
@@ -76,6 +82,11 @@ class CyclicExchange {
   // dropped.
   Status build(const ProcessImageLayout& layout, const MacAddress& source);
   bool built() const { return layout_ != nullptr; }
+  // Sends from now on the datagrams active in `state` (LogicalDatagram::states); before the
+  // first call every datagram is. kState while a frame is in flight.
+  Status setState(AlState state);
+  // False for a datagram left out in the current state.
+  bool active(std::size_t datagram) const { return datagrams_[datagram].active; }
   std::size_t frameCount() const { return frames_.size(); }
   const CachedFrame& frame(std::size_t n) const { return *frames_[n]; }
 
@@ -101,6 +112,7 @@ class CyclicExchange {
   // Distributed clocks (master/dc.hpp): with a reference clock's station address, build()
   // appends to the first frame an FRMW of its system time 0x0910 (8 bytes), so every cycle
   // distributes the reference time and drives the slaves' drift control loops. nullopt: none.
+  // A layout that has its own FRMW/ARMW of 0x0910 (an ENI's) uses that one instead.
   void setDcReference(std::optional<std::uint16_t> station) { dcReference_ = station; }
   // The reference clock's system time carried back by the last answered frame.
   std::optional<std::uint64_t> dcSystemTime() const;
@@ -127,7 +139,10 @@ class CyclicExchange {
   struct DatagramRef {
     std::size_t frame{0};
     std::size_t index{0};  // within the frame
+    bool active{true};
   };
+  Status assemble();
+  bool isActive(const LogicalDatagram& d) const { return !state_ || d.activeIn(*state_); }
 
   const ProcessImageLayout* layout_{nullptr};
   std::vector<std::unique_ptr<CachedFrame>> frames_;
@@ -141,7 +156,9 @@ class CyclicExchange {
   SimTime deadline_{0};
   std::optional<SimTime> lastSend_;
   std::optional<std::uint16_t> dcReference_;
-  std::optional<std::size_t> dcDatagram_;  // index of the FRMW in frame 0
+  std::optional<DatagramRef> dcDatagram_;  // the FRMW/ARMW of the reference's system time
+  MacAddress source_{};
+  std::optional<AlState> state_;
 };
 
 }  // namespace ecsim::master

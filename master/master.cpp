@@ -163,6 +163,13 @@ Status Master::readStates() {
 
 Status Master::requestState(AlState target) {
   ECSIM_TRY(runInitCommands(target, InitPhase::kBefore));
+  // Cyclic datagrams of a state (an ENI Cmd's <State>) go out once every slave is in it.
+  AlState lowest = target;
+  for (const auto& s : slaves_) {
+    const AlState state = s.state().value_or(AlState::kInit);
+    if (rank(state) < rank(lowest)) lowest = state;
+  }
+  ECSIM_TRY(cyclic_.setState(lowest));
   StateChangeTask task(transport_, slaves_, options_.state);
   task.start(target, bus_.now());
   const SimTime timeout = options_.state.timeout + kNsPerSecond;
@@ -179,6 +186,7 @@ Status Master::requestState(AlState target) {
   refusals_ = task.refusals();
   ECSIM_TRY(ran);
   ECSIM_TRY(task.status());
+  ECSIM_TRY(cyclic_.setState(target));
   return runInitCommands(target, InitPhase::kAfter);
 }
 
@@ -207,7 +215,8 @@ Status Master::configureProcessData() {
     // CoE without bits (or no CoE): the SII says (as SOEM decides).
     if (data.outputBits() + data.inputBits() == 0) data = processDataFromSii(slave);
   }
-  ECSIM_ASSIGN_OR_RETURN(layout_, planProcessImage(slaves_, processData_, options_.layout));
+  // An ENI's cyclic frames, else the master's own (master/eni_config.hpp).
+  ECSIM_ASSIGN_OR_RETURN(layout_, planLayout(config_, slaves_, processData_, options_.layout));
   if (layout_.frameCount > transport_.options().maxFramesInFlight) {
     return makeError(ErrorCode::kTooLarge,
                      "process image needs " + std::to_string(layout_.frameCount) +
@@ -232,6 +241,9 @@ Status Master::configureProcessData() {
     for (const auto& expected : config_->slaves) names.push_back(expected.name);
   }
   variables_ = nameVariables(layout_, slaves_, names);
+  if (config_ && config_->eni && !config_->eni->cyclic.empty()) {
+    ECSIM_TRY(addEniVariables(variables_, *config_->eni, layout_));  // the ENI's names too
+  }
   return okStatus();
 }
 

@@ -82,19 +82,8 @@ Result<ProcessImageLayout> planProcessImage(const std::vector<SlaveInfo>& slaves
     if (outputs) layout.outputBytes = offset;
   }
   layout.inputBytes = offset - layout.outputBytes;
-  // One FMMU per SM with data, outputs first.
   for (auto& sl : layout.slaves) {
-    for (bool outputs : {true, false}) {
-      for (const auto& sm : sl.sms) {
-        if (sm.outputs != outputs || sm.setting.length == 0) continue;
-        FmmuSetting f;
-        f.logicalStart = sm.logicalStart;
-        f.length = sm.setting.length;
-        f.physicalStart = sm.setting.start;
-        f.type = outputs ? reg::fmmu::kTypeWrite : reg::fmmu::kTypeRead;
-        sl.fmmus.push_back(f);
-      }
-    }
+    sl.fmmus = fmmusOf(sl);
     if (sl.fmmus.size() > sl.fmmuCount) {
       return makeError(ErrorCode::kUnsupported,
                        slaves[sl.position].label() + ": needs " + std::to_string(sl.fmmus.size()) +
@@ -155,6 +144,22 @@ Result<ProcessImageLayout> planProcessImage(const std::vector<SlaveInfo>& slaves
   }
   layout.frameCount = layout.datagrams.empty() ? 0 : frame + 1;
   return layout;
+}
+
+std::vector<FmmuSetting> fmmusOf(const SlaveLayout& slave) {
+  std::vector<FmmuSetting> fmmus;
+  for (bool outputs : {true, false}) {
+    for (const auto& sm : slave.sms) {
+      if (sm.outputs != outputs || sm.setting.length == 0) continue;
+      FmmuSetting f;
+      f.logicalStart = sm.logicalStart;
+      f.length = sm.setting.length;
+      f.physicalStart = sm.setting.start;
+      f.type = outputs ? reg::fmmu::kTypeWrite : reg::fmmu::kTypeRead;
+      fmmus.push_back(f);
+    }
+  }
+  return fmmus;
 }
 
 void addProcessDataSetup(DatagramBatch& batch, const ProcessImageLayout& layout) {

@@ -13,6 +13,9 @@
 //             counting per datagram, not per FMMU (notes/soem-interop.md §3.6); the slaves
 //             it touches are kept to name them when the WKC is wrong
 //   frames    datagrams packed in order into frames of at most 1514 bytes
+//
+// A master configured from an ENI with cyclic frames places the slaves and takes the datagrams
+// from the ENI instead (master/eni_config.hpp: planEniLayout), into these same structures.
 #pragma once
 
 #include <cstdint>
@@ -24,6 +27,8 @@
 #include "master/pdo_config.hpp"
 #include "master/slave_info.hpp"
 #include "master/transport.hpp"
+#include "protocol/al_status.hpp"
+#include "protocol/frame.hpp"
 
 namespace ecsim::master {
 
@@ -48,12 +53,28 @@ struct SlaveLayout {
   std::uint32_t inputBytes{0};
 };
 
+// AlState values as bits of LogicalDatagram::states.
+constexpr std::uint8_t kAllStates = 0xFF;
+constexpr std::uint8_t stateBit(AlState state) {
+  return static_cast<std::uint8_t>(state);
+}
+
 struct LogicalDatagram {
+  // The address field: the logical address of LRD/LWR/LRW, else ADP | ADO << 16.
   std::uint32_t logicalStart{0};
   std::uint16_t length{0};
   std::uint16_t expectedWkc{0};
   std::vector<std::size_t> slaves;  // positions of the slaves it touches
   std::size_t frame{0};
+  // planProcessImage() makes LRWs sent in every state. An ENI's cyclic Cmd may be any command
+  // (master/eni_config.hpp): only logical ones exchange image bytes (outputs copied into the
+  // frame for LWR/LRW, inputs copied out for LRD/LRW); the others carry their WKC only. It is
+  // sent while the bus is in one of `states` (stateBit() values); checkWkc false: no <Cnt>.
+  Command command{Command::kLrw};
+  std::uint8_t states{kAllStates};
+  bool checkWkc{true};
+  int line{0};  // the ENI line of the Cmd, 0 when planned
+  bool activeIn(AlState state) const { return (states & stateBit(state)) != 0; }
 };
 
 struct ProcessImageLayout {
@@ -78,6 +99,10 @@ struct LayoutOptions {
 Result<ProcessImageLayout> planProcessImage(const std::vector<SlaveInfo>& slaves,
                                             const std::vector<SlaveProcessData>& processData,
                                             const LayoutOptions& options = {});
+
+// One FMMU per SM with data, outputs first: logical range -> SM start, type write for outputs,
+// read for inputs (after the SMs' logicalStart are set).
+std::vector<FmmuSetting> fmmusOf(const SlaveLayout& slave);
 
 // The SM and FMMU writes of the layout, one FPWR per SM and one per slave for its FMMUs.
 void addProcessDataSetup(DatagramBatch& batch, const ProcessImageLayout& layout);
