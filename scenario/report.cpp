@@ -42,6 +42,11 @@ std::string Expectation::describe() const {
       return fmt::format("Detected {}{} within {} cycles after cycle {}", condition,
                          slave.empty() ? "" : " of " + slave, withinCycles, afterCycle);
     case ExpectKind::kBackInOp:
+      if (afterTime) {
+        return fmt::format("BackInOp within {:.3f} ms after {:.3f} ms",
+                           static_cast<double>(within) / kNsPerMs,
+                           static_cast<double>(*afterTime) / kNsPerMs);
+      }
       return fmt::format("BackInOp within {:.3f} ms after cycle {}",
                          static_cast<double>(within) / kNsPerMs, afterCycle);
     case ExpectKind::kRegister:
@@ -61,6 +66,11 @@ std::string Expectation::describe() const {
     case ExpectKind::kVariable:
       return fmt::format("Variable {} {:#06x}:{:02x} {}{}", slave, index, subindex, cmp,
                          when(*this));
+    case ExpectKind::kExitStatus:
+      return fmt::format("ExitStatus {}", cmp);
+    case ExpectKind::kOutput:
+      return fmt::format("Output {} \"{}\"{}", isRegex ? "matches" : "contains", text,
+                         countLines ? fmt::format(" in {} lines", cmp) : std::string());
   }
   return "?";
 }

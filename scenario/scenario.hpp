@@ -44,6 +44,8 @@ enum class ExpectKind : std::uint8_t {
   kStatistic,   // a master statistic at a time
   kContinuity,  // bounds on cycles without fresh process data
   kVariable,    // a process-data entry as the master sees it, at a time
+  kExitStatus,  // external master: the command's exit status (at the end)
+  kOutput,      // external master: lines of the command's output (at the end)
 };
 
 enum class Compare : std::uint8_t { kEq, kNe, kLt, kLe, kGt, kGe };
@@ -59,6 +61,7 @@ struct Expectation {
   std::optional<std::uint16_t> code;  // kState: AL status code
   std::string condition;              // kDetected
   std::uint64_t afterCycle{0};        // kDetected, kBackInOp
+  std::optional<SimTime> afterTime;   // kBackInOp (afterMs; external masters only)
   std::uint64_t withinCycles{0};      // kDetected
   SimTime within{0};                  // kBackInOp
   std::uint16_t address{0};           // kRegister
@@ -73,7 +76,10 @@ struct Expectation {
   double tolerance{0};
   std::uint64_t maxBadCycles{0};             // kContinuity
   std::uint64_t maxConsecutiveBadCycles{0};  // kContinuity
-  bool needsRecovery{false};                 // documented: fails when the master does not react
+  std::string text;                          // kOutput: contains="..." or matches="regex"
+  bool isRegex{false};                       // kOutput: text is an ECMAScript regular expression
+  bool countLines{false};     // kOutput: compare the number of lines found (op, value)
+  bool needsRecovery{false};  // documented: fails when the master does not react
   std::string describe() const;
 };
 
@@ -84,6 +90,11 @@ struct Scenario {
   std::filesystem::path topology;
   std::string masterKind{"in-process"};  // or "external"
   std::string masterCommand;             // external
+  // External masters (docs/scenarios.md, "External masters"):
+  int masterLine{0};                        // of <Master>, for errors about the command
+  SimTime startTimeout{30 * kNsPerSecond};  // command start to all slaves in OP
+  SimTime stopGrace{2 * kNsPerSecond};      // SIGTERM to SIGKILL when the time is up
+  bool timeFromStart{false};                // timeZero="start": time 0 is the command's start
   SimTime cycleTime{kNsPerMs};
   SimTime duration{kNsPerSecond};
   std::uint64_t seed{1};
@@ -93,6 +104,11 @@ struct Scenario {
 
 Result<Scenario> loadScenario(const std::filesystem::path& path);
 Result<Scenario> parseScenario(std::string_view xml, const std::filesystem::path& path);
+// What an external master can be judged on: rejects (naming file and line) the expectations
+// that need the master's internals (Detected, Statistic, Variable, Continuity) and the
+// pause-master action for external masters, and ExitStatus, Output and BackInOp afterMs for the
+// in-process one. parseScenario() calls it.
+Status checkMasterKind(const Scenario& scenario);
 
 std::string_view toString(Compare c);
 bool compareValues(double observed, Compare c, double expected, double tolerance = 0);

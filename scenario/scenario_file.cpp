@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <regex>
 #include <sstream>
 
 #include "scenario/scenario.hpp"
@@ -153,9 +154,43 @@ Result<Expectation> readExpectation(const Reader& r, const XMLElement* e) {
     x.kind = ExpectKind::kBackInOp;
     ECSIM_ASSIGN_OR_RETURN(auto after, r.number(e, "afterCycle"));
     ECSIM_ASSIGN_OR_RETURN(auto within, r.millis(e, "withinMs"));
+    ECSIM_ASSIGN_OR_RETURN(x.afterTime, r.millis(e, "afterMs"));
     if (!within) return r.error(e, "BackInOp needs withinMs=\"T\"");
+    if (after && x.afterTime) return r.error(e, "BackInOp takes afterCycle or afterMs, not both");
     x.afterCycle = after.value_or(0);
     x.within = *within;
+  } else if (tag == "ExitStatus" || tag == "Output") {
+    // External masters: judged once the command has ended.
+    if (x.atCycle || x.atTime) {
+      return r.error(e, tag + " is checked when the command has ended: no cycle or atMs");
+    }
+    if (tag == "ExitStatus") {
+      x.kind = ExpectKind::kExitStatus;
+      ECSIM_TRY(needValue());
+    } else {
+      x.kind = ExpectKind::kOutput;
+      auto contains = Reader::attr(e, "contains");
+      auto matches = Reader::attr(e, "matches");
+      if (contains.has_value() == matches.has_value() ||
+          (contains ? *contains : *matches).empty()) {
+        return r.error(e, "Output needs exactly one of contains=\"TEXT\" and matches=\"REGEX\"");
+      }
+      x.isRegex = matches.has_value();
+      x.text = contains ? *contains : *matches;
+      x.countLines = value.has_value();
+      if (!x.countLines && Reader::attr(e, "op")) {
+        return r.error(e, "Output with op=\"...\" needs value=\"N\" (a number of lines)");
+      }
+      if (x.isRegex) {
+        // std::regex reports a bad pattern only by throwing: caught here, at file loading.
+        try {
+          std::regex check(x.text, std::regex::ECMAScript);
+        } catch (const std::regex_error& bad) {
+          return r.error(e,
+                         "matches=\"" + x.text + "\" is not a regular expression: " + bad.what());
+        }
+      }
+    }
   } else if (tag == "Register") {
     x.kind = ExpectKind::kRegister;
     ECSIM_TRY(needSlave());
@@ -290,9 +325,22 @@ Result<Scenario> parseScenario(std::string_view xml, const std::filesystem::path
       return r.error(m, "Master kind must be in-process or external");
     }
     s.masterCommand = Reader::attr(m, "command").value_or("");
+    s.masterLine = m->GetLineNum();
     if (s.masterKind == "external" && s.masterCommand.empty()) {
       return r.error(m, "an external Master needs command=\"...\"");
     }
+    ECSIM_ASSIGN_OR_RETURN(auto startTimeout, r.millis(m, "startTimeoutMs"));
+    ECSIM_ASSIGN_OR_RETURN(auto stopGrace, r.millis(m, "stopGraceMs"));
+    const auto timeZero = Reader::attr(m, "timeZero");
+    if (s.masterKind != "external" && (startTimeout || stopGrace || timeZero)) {
+      return r.error(m, "startTimeoutMs, stopGraceMs and timeZero are for external masters only");
+    }
+    if (startTimeout) s.startTimeout = *startTimeout;
+    if (stopGrace) s.stopGrace = *stopGrace;
+    if (timeZero && *timeZero != "op" && *timeZero != "start") {
+      return r.error(m, "timeZero=\"" + *timeZero + "\" is not op or start");
+    }
+    s.timeFromStart = timeZero.value_or("op") == "start";
   }
   if (const auto* t = root->FirstChildElement("Timeline")) {
     for (const auto* e = t->FirstChildElement(); e != nullptr; e = e->NextSiblingElement()) {
@@ -310,7 +358,44 @@ Result<Scenario> parseScenario(std::string_view xml, const std::filesystem::path
     }
   }
   if (s.expectations.empty()) return r.error(root, "a scenario needs at least one expectation");
+  ECSIM_TRY(checkMasterKind(s));
   return s;
+}
+
+Status checkMasterKind(const Scenario& s) {
+  const bool external = s.masterKind == "external";
+  auto refuse = [&](int line, const std::string& what) -> Status {
+    return makeError(ErrorCode::kParse,
+                     s.file.string() + ", line " + std::to_string(line) + ": " + what);
+  };
+  for (const auto& a : s.actions) {
+    if (external && a.action.verb == "pause-master") {
+      return refuse(a.line,
+                    "pause-master needs our master: an external master sends what it sends");
+    }
+  }
+  for (const auto& x : s.expectations) {
+    const char* inner = x.kind == ExpectKind::kDetected     ? "Detected"
+                        : x.kind == ExpectKind::kStatistic  ? "Statistic"
+                        : x.kind == ExpectKind::kVariable   ? "Variable"
+                        : x.kind == ExpectKind::kContinuity ? "Continuity"
+                                                            : nullptr;
+    if (external && inner != nullptr) {
+      return refuse(x.line, std::string(inner) +
+                                " looks inside the master, which an external master does not "
+                                "show: judge it by State, Register, BackInOp, ExitStatus or "
+                                "Output");
+    }
+    const bool commandOnly = x.kind == ExpectKind::kExitStatus || x.kind == ExpectKind::kOutput;
+    if (!external && commandOnly) {
+      return refuse(x.line, std::string(x.kind == ExpectKind::kOutput ? "Output" : "ExitStatus") +
+                                " judges an external master's command (Master kind=\"external\")");
+    }
+    if (!external && x.afterTime) {
+      return refuse(x.line, "BackInOp afterMs is for external masters; ours counts afterCycle");
+    }
+  }
+  return okStatus();
 }
 
 }  // namespace ecsim::scenario

@@ -1,7 +1,9 @@
 // `ecsim scenario run FILE... [--seed N] [--pcap DIR] [--junit FILE] [--no-recovery]`: runs
-// scenario files (docs/scenarios.md) with our master in-process on virtual time, prints a
+// scenario files (docs/scenarios.md) with our master in-process on virtual time, or with an
+// external master command over a veth pair in real time (<Master kind="external">), prints a
 // report per expectation and exits non-zero when any expectation fails or a scenario cannot
-// run.
+// run. An external master's output is kept next to the capture (--pcap DIR) or the JUnit
+// file as <scenario name>.output.txt.
 #include <fmt/core.h>
 
 #include <filesystem>
@@ -10,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "scenario/external_runner.hpp"
 #include "scenario/runner.hpp"
 #include "scenario/scenario.hpp"
 #include "tools/ecsim/commands.hpp"
@@ -34,6 +37,12 @@ int runScenarios(const ScenarioOptions& o) {
     std::filesystem::create_directories(o.pcapDir, ec);
     run.pcapDir = o.pcapDir;
   }
+  scenario::ExternalRunOptions external;
+  if (!o.pcapDir.empty()) {
+    external.outputDir = o.pcapDir;
+  } else if (!o.junit.empty()) {
+    external.outputDir = std::filesystem::absolute(o.junit).parent_path();
+  }
   std::vector<scenario::ScenarioResult> results;
   bool allPassed = true;
   for (const auto& file : o.files) {
@@ -48,7 +57,7 @@ int runScenarios(const ScenarioOptions& o) {
       allPassed = false;
       continue;
     }
-    auto result = scenario::runScenario(*loaded, run);
+    auto result = scenario::runAnyScenario(*loaded, run, external);
     fmt::print("{}\n", scenario::formatReport(result));
     allPassed = allPassed && result.passed();
     results.push_back(std::move(result));

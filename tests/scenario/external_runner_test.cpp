@@ -1,0 +1,200 @@
+// External masters in scenario files (docs/scenarios.md, "External masters"), without running
+// anything: the ExitStatus/Output/BackInOp afterMs additions, the <Master> timeouts, the
+// refusal of expectations that need the master's internals (each error names file and line),
+// and the command's {iface}/${NAME} expansion.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <map>
+
+#include "scenario/external_runner.hpp"
+#include "scenario/scenario.hpp"
+
+namespace ecsim::scenario {
+namespace {
+
+const std::filesystem::path kDir = std::filesystem::path(ECSIM_SOURCE_DIR) / "scenarios";
+
+// Line 1 is the XML declaration, line 2 <Scenario>, line 3 <Master>, the body from line 4.
+std::string wrap(const std::string& master, const std::string& body) {
+  return "<?xml version=\"1.0\"?>\n<Scenario name=\"t\" topology=\"demo.xml\" "
+         "durationMs=\"100\">\n" +
+         master + "\n" + body + "</Scenario>\n";
+}
+
+const std::string kExternal = "<Master kind=\"external\" command=\"run {iface}\"/>";
+
+std::string errorOf(const Result<Scenario>& s) {
+  return s.ok() ? std::string("(parsed)") : s.error().context;
+}
+
+TEST(ExternalScenarioFile, ReadsCommandExpectationsAndTimeouts) {
+  auto s = parseScenario(
+      wrap("<Master kind=\"external\" command=\"${SOEM_DIR}/simple_test {iface}\" "
+           "startTimeoutMs=\"5000\" stopGraceMs=\"250\" timeZero=\"start\"/>",
+           "<Expect>\n"
+           "  <ExitStatus value=\"0\"/>\n"
+           "  <Output contains=\"all slaves\"/>\n"
+           "  <Output matches=\"^Processdata cycle +[0-9]+, WKC 10 \" op=\"ge\" value=\"9900\"/>\n"
+           "  <BackInOp afterMs=\"2000\" withinMs=\"500\"/>\n"
+           "  <State slave=\"DI1\" state=\"OP\" cycle=\"40\"/>\n"
+           "</Expect>\n"),
+      "/x/e.xml");
+  ASSERT_TRUE(s.ok()) << s.error().message();
+  EXPECT_EQ(s->masterKind, "external");
+  EXPECT_EQ(s->masterCommand, "${SOEM_DIR}/simple_test {iface}");
+  EXPECT_EQ(s->masterLine, 3);
+  EXPECT_EQ(s->startTimeout, 5 * kNsPerSecond);
+  EXPECT_EQ(s->stopGrace, 250 * kNsPerMs);
+  EXPECT_TRUE(s->timeFromStart);
+  ASSERT_EQ(s->expectations.size(), 5u);
+  const auto& exit = s->expectations[0];
+  EXPECT_EQ(exit.kind, ExpectKind::kExitStatus);
+  EXPECT_EQ(exit.line, 5);
+  EXPECT_EQ(exit.describe(), "ExitStatus == 0");
+  const auto& contains = s->expectations[1];
+  EXPECT_EQ(contains.kind, ExpectKind::kOutput);
+  EXPECT_FALSE(contains.isRegex);
+  EXPECT_FALSE(contains.countLines);
+  EXPECT_EQ(contains.text, "all slaves");
+  EXPECT_EQ(contains.describe(), "Output contains \"all slaves\"");
+  const auto& matches = s->expectations[2];
+  EXPECT_TRUE(matches.isRegex);
+  EXPECT_TRUE(matches.countLines);
+  EXPECT_EQ(matches.compare, Compare::kGe);
+  EXPECT_EQ(matches.value, 9900);
+  EXPECT_EQ(matches.describe(),
+            "Output matches \"^Processdata cycle +[0-9]+, WKC 10 \" in >= 9900 lines");
+  const auto& back = s->expectations[3];
+  ASSERT_TRUE(back.afterTime.has_value());
+  EXPECT_EQ(*back.afterTime, 2000 * kNsPerMs);
+  EXPECT_EQ(back.describe(), "BackInOp within 500.000 ms after 2000.000 ms");
+  EXPECT_EQ(s->expectations[4].atCycle, 40u);
+}
+
+TEST(ExternalScenarioFile, DefaultsTimeZeroAtOpAndTimeouts) {
+  auto s = parseScenario(wrap(kExternal, "<Expect><ExitStatus value=\"0\"/></Expect>\n"), "e.xml");
+  ASSERT_TRUE(s.ok()) << s.error().message();
+  EXPECT_FALSE(s->timeFromStart);
+  EXPECT_EQ(s->startTimeout, 30 * kNsPerSecond);
+  EXPECT_EQ(s->stopGrace, 2 * kNsPerSecond);
+}
+
+TEST(ExternalScenarioFile, RefusesWhatNeedsTheMastersInternals) {
+  const std::map<std::string, std::string> inner = {
+      {"Detected", "<Detected condition=\"wkc-error\" withinCycles=\"5\"/>"},
+      {"Statistic", "<Statistic name=\"framesLost\" value=\"0\"/>"},
+      {"Variable", "<Variable slave=\"DI1\" entry=\"0x6000:01\" value=\"1\"/>"},
+      {"Continuity", "<Continuity maxBadCycles=\"3\"/>"},
+  };
+  for (const auto& [tag, element] : inner) {
+    auto s = parseScenario(
+        wrap(kExternal, "<Expect>\n  <ExitStatus value=\"0\"/>\n  " + element + "\n</Expect>\n"),
+        "ext.xml");
+    ASSERT_FALSE(s.ok()) << tag;
+    EXPECT_NE(errorOf(s).find("ext.xml, line 6: " + tag + " looks inside the master"),
+              std::string::npos)
+        << errorOf(s);
+    // The same expectation is fine for our master.
+    auto ours = parseScenario(
+        wrap("<Master kind=\"in-process\"/>", "<Expect>" + element + "</Expect>"), "ours.xml");
+    EXPECT_TRUE(ours.ok()) << tag << ": " << errorOf(ours);
+  }
+  auto pause = parseScenario(
+      wrap(kExternal,
+           "<Timeline>\n  <Action timeMs=\"5\" do=\"pause-master\" durationMs=\"50\"/>\n"
+           "</Timeline>\n<Expect><ExitStatus value=\"0\"/></Expect>\n"),
+      "p.xml");
+  ASSERT_FALSE(pause.ok());
+  EXPECT_NE(errorOf(pause).find("p.xml, line 5: pause-master"), std::string::npos)
+      << errorOf(pause);
+}
+
+TEST(ExternalScenarioFile, RefusesCommandExpectationsForOurMaster) {
+  auto s = parseScenario(wrap("<Master kind=\"in-process\"/>",
+                              "<Expect>\n  <State slave=\"DI1\" state=\"OP\"/>\n"
+                              "  <Output contains=\"x\"/>\n</Expect>\n"),
+                         "in.xml");
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(errorOf(s).find("in.xml, line 6: Output judges an external master's command"),
+            std::string::npos)
+      << errorOf(s);
+  s = parseScenario(wrap("", "<Expect>\n<ExitStatus value=\"0\"/>\n</Expect>\n"), "d.xml");
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(errorOf(s).find("d.xml, line 5: ExitStatus"), std::string::npos) << errorOf(s);
+  s = parseScenario(wrap("", "<Expect>\n<BackInOp afterMs=\"5\" withinMs=\"5\"/>\n</Expect>\n"),
+                    "b.xml");
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(errorOf(s).find("b.xml, line 5: BackInOp afterMs"), std::string::npos) << errorOf(s);
+  s = parseScenario(wrap("<Master startTimeoutMs=\"5\"/>",
+                         "<Expect><State slave=\"A\" "
+                         "state=\"OP\"/></Expect>"),
+                    "m.xml");
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(errorOf(s).find("m.xml, line 3: startTimeoutMs"), std::string::npos) << errorOf(s);
+}
+
+TEST(ExternalScenarioFile, ErrorsInTheAdditionsNameTheLine) {
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"<Output/>", "exactly one of contains"},
+      {"<Output contains=\"a\" matches=\"b\"/>", "exactly one of contains"},
+      {"<Output matches=\"(unclosed\"/>", "is not a regular expression"},
+      {"<Output contains=\"a\" op=\"ge\"/>", "needs value"},
+      {"<ExitStatus/>", "ExitStatus needs value"},
+      {"<ExitStatus value=\"0\" atMs=\"5\"/>", "checked when the command has ended"},
+      {"<BackInOp afterCycle=\"1\" afterMs=\"5\" withinMs=\"5\"/>", "not both"},
+  };
+  for (const auto& [element, message] : bad) {
+    auto s = parseScenario(wrap(kExternal, "<Expect>\n" + element + "\n</Expect>\n"), "x.xml");
+    ASSERT_FALSE(s.ok()) << element;
+    EXPECT_NE(errorOf(s).find("x.xml, line 5: "), std::string::npos) << errorOf(s);
+    EXPECT_NE(errorOf(s).find(message), std::string::npos) << errorOf(s);
+  }
+  auto s = parseScenario(wrap("<Master kind=\"external\" command=\"x\" timeZero=\"never\"/>",
+                              "<Expect><ExitStatus value=\"0\"/></Expect>"),
+                         "z.xml");
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(errorOf(s).find("z.xml, line 3: timeZero=\"never\""), std::string::npos) << errorOf(s);
+}
+
+TEST(ExternalCommand, ExpandsInterfaceAndEnvironment) {
+  Scenario s;
+  s.file = "/x/e.xml";
+  s.masterLine = 7;
+  s.masterCommand = "${SOEM_DIR}/bin-v1/simple_test {iface} && echo {iface} $HOME";
+  const Environment env = [](const std::string& name) -> std::optional<std::string> {
+    if (name == "SOEM_DIR") return std::string("/opt/soem");
+    return std::nullopt;
+  };
+  auto c = expandCommand(s, "ecm-1234", env);
+  ASSERT_TRUE(c.ok()) << c.error().message();
+  // Only the braced form is ours: $HOME is left to the shell.
+  EXPECT_EQ(*c, "/opt/soem/bin-v1/simple_test ecm-1234 && echo ecm-1234 $HOME");
+  s.masterCommand = "${NOT_SET}/x {iface}";
+  c = expandCommand(s, "ecm-1234", env);
+  ASSERT_FALSE(c.ok());
+  EXPECT_NE(c.error().context.find("/x/e.xml, line 7: ${NOT_SET} in the command is not set"),
+            std::string::npos)
+      << c.error().context;
+  s.masterCommand = "${SOEM_DIR";
+  c = expandCommand(s, "ecm-1234", env);
+  ASSERT_FALSE(c.ok());
+  EXPECT_NE(c.error().context.find("unterminated"), std::string::npos) << c.error().context;
+}
+
+TEST(ExternalScenarioFile, ShippedExternalScenariosLoad) {
+  std::size_t count = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(kDir / "external")) {
+    if (entry.path().extension() != ".xml") continue;
+    auto s = loadScenario(entry.path());
+    ASSERT_TRUE(s.ok()) << s.error().message();
+    EXPECT_EQ(s->masterKind, "external") << entry.path();
+    EXPECT_NE(s->masterCommand.find("{iface}"), std::string::npos) << entry.path();
+    EXPECT_TRUE(std::filesystem::exists(s->topology)) << s->topology;
+    ++count;
+  }
+  EXPECT_GE(count, 2u);
+}
+
+}  // namespace
+}  // namespace ecsim::scenario

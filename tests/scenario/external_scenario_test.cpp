@@ -1,0 +1,185 @@
+// Scenarios with an external master over a veth pair in a private network namespace (needs
+// CAP_NET_ADMIN, CAP_NET_RAW, CAP_SYS_ADMIN: under CI=true their absence fails, elsewhere the
+// tests skip). Small shell commands show the mechanics (exit status, output, stopping at the
+// end, a failing report); SOEM v1.4.0's simple_test, built into the build tree by the interop
+// tests' `soem` fixture (../shared/tools/build-soem.sh), runs the shipped scenarios in
+// scenarios/external/.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "link/netns.hpp"
+#include "scenario/external_runner.hpp"
+#include "scenario/scenario.hpp"
+#include "support/privileges.hpp"
+
+namespace ecsim::scenario {
+namespace {
+
+const std::filesystem::path kSource = ECSIM_SOURCE_DIR;
+const std::filesystem::path kSoem = ECSIM_SOEM_DIR;
+const std::string kEcsim = std::string(ECSIM_BINARY_DIR) + "/tools/ecsim/ecsim";
+
+#define ECSIM_REQUIRE_SOEM()                                                               \
+  do {                                                                                     \
+    ECSIM_REQUIRE_NETWORK();                                                               \
+    if (!std::filesystem::exists(kSoem / "bin-v1" / "simple_test")) {                      \
+      if (::ecsim::testing::ciModeForPrivileges())                                         \
+        FAIL() << "SOEM not built in " << kSoem << " (../shared missing?)";                \
+      GTEST_SKIP() << "SOEM not built in " << kSoem << " (../shared/tools/build-soem.sh)"; \
+    }                                                                                      \
+  } while (false)
+
+std::string readText(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class ExternalScenario : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("ecsim-external-" + std::to_string(::getpid()) + "-" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  // A scenario on the demo network with the given master element and expectations.
+  Scenario write(const std::string& master, const std::string& expect,
+                 const std::string& attributes = "durationMs=\"300\"") {
+    const auto file = dir_ / "t.xml";
+    std::ofstream(file) << "<?xml version=\"1.0\"?>\n<Scenario name=\"t\" topology=\""
+                        << (kSource / "examples/topologies/demo.xml").string() << "\" "
+                        << attributes << ">\n"
+                        << master << "\n<Expect>\n"
+                        << expect << "</Expect>\n</Scenario>\n";
+    auto s = loadScenario(file);
+    EXPECT_TRUE(s.ok()) << s.error().message();
+    return s.ok() ? *s : Scenario{};
+  }
+
+  // No namespace of this process is left behind.
+  static void expectNoNamespaceLeft() {
+    auto list = runCommand({"ip", "netns", "list"});
+    ASSERT_TRUE(list.ok());
+    EXPECT_EQ(list->output.find("ecsim-" + std::to_string(::getpid()) + "-"), std::string::npos)
+        << list->output;
+  }
+
+  std::filesystem::path dir_;
+};
+
+TEST_F(ExternalScenario, AFailingCommandGivesAFailingReportNamingTheExpectation) {
+  ECSIM_REQUIRE_NETWORK();
+  // Line 1 declaration, 2 Scenario, 3 Master, 4 Expect, 5 and 6 the expectations.
+  auto s = write("<Master kind=\"external\" command=\"false\"/>",
+                 "<ExitStatus value=\"0\"/>\n<Output contains=\"slaves found\"/>\n");
+  auto r = runExternalScenario(s);
+  ASSERT_TRUE(r.error.empty()) << r.error;
+  EXPECT_FALSE(r.passed());
+  const std::string report = formatReport(r);
+  EXPECT_NE(report.find("FAIL  t.xml, line 5: ExitStatus == 0\n"), std::string::npos) << report;
+  EXPECT_NE(report.find(": exit status 1\n"), std::string::npos) << report;
+  EXPECT_NE(report.find("FAIL  t.xml, line 6: Output contains \"slaves found\""), std::string::npos)
+      << report;
+  EXPECT_NE(report.find("not found in 0 lines of output"), std::string::npos) << report;
+  EXPECT_NE(report.find("the command exited with status 1"), std::string::npos) << report;
+  EXPECT_NE(report.find("never had all slaves in OP"), std::string::npos) << report;
+  const std::string junit = formatJunit({r});
+  EXPECT_NE(junit.find("<failure message=\""), std::string::npos) << junit;
+  expectNoNamespaceLeft();
+}
+
+TEST_F(ExternalScenario, TheCommandSeesItsInterfaceAndItsOutputIsJudged) {
+  ECSIM_REQUIRE_NETWORK();
+  // timeZero="start": nothing brings the slaves to OP here.
+  auto s = write(
+      "<Master kind=\"external\" timeZero=\"start\" command=\"ip -o link show {iface}; echo "
+      "done ${ECSIM_TEST_WORD}\"/>",
+      "<ExitStatus value=\"0\"/>\n<Output matches=\"^[0-9]+: ecm-[0-9a-f]{8}@\"/>\n"
+      "<Output contains=\"done bird\" op=\"eq\" value=\"1\"/>\n"
+      "<State slave=\"Drive2\" state=\"INIT\"/>\n");
+  ExternalRunOptions external;
+  external.outputDir = dir_;
+  external.environment = [](const std::string& name) -> std::optional<std::string> {
+    if (name == "ECSIM_TEST_WORD") return std::string("bird");
+    return std::nullopt;
+  };
+  auto r = runExternalScenario(s, {}, external);
+  ASSERT_TRUE(r.error.empty()) << r.error;
+  EXPECT_TRUE(r.passed()) << formatReport(r);
+  EXPECT_NE(readText(dir_ / "t.output.txt").find("done bird"), std::string::npos);
+  expectNoNamespaceLeft();
+}
+
+TEST_F(ExternalScenario, ACommandStillRunningAtTheEndIsStopped) {
+  ECSIM_REQUIRE_NETWORK();
+  auto s = write(
+      "<Master kind=\"external\" timeZero=\"start\" stopGraceMs=\"500\" "
+      "command=\"echo started; sleep 30\"/>",
+      "<ExitStatus value=\"143\"/>\n<Output contains=\"started\"/>\n");
+  const auto before = std::chrono::steady_clock::now();
+  auto r = runExternalScenario(s);
+  EXPECT_LT(std::chrono::steady_clock::now() - before, std::chrono::seconds(10));
+  ASSERT_TRUE(r.error.empty()) << r.error;
+  EXPECT_TRUE(r.passed()) << formatReport(r);
+  EXPECT_NE(formatReport(r).find("command stopped (stopped with SIGTERM)"), std::string::npos)
+      << formatReport(r);
+  expectNoNamespaceLeft();
+}
+
+TEST_F(ExternalScenario, SoemSimpleTestRunsToTheEndInOp) {
+  ECSIM_REQUIRE_SOEM();
+  auto s = loadScenario(kSource / "scenarios/external/soem_simple_test.xml");
+  ASSERT_TRUE(s.ok()) << s.error().message();
+  ExternalRunOptions external;
+  external.outputDir = dir_;
+  external.environment = [](const std::string& name) -> std::optional<std::string> {
+    if (name == "SOEM_DIR") return kSoem.string();
+    return std::nullopt;
+  };
+  RunOptions options;
+  options.pcapDir = dir_;
+  auto r = runExternalScenario(*s, options, external);
+  const std::string report = formatReport(r);
+  std::cout << report;
+  ASSERT_TRUE(r.error.empty()) << r.error;
+  EXPECT_TRUE(r.passed()) << report;
+  EXPECT_GE(r.cycles, 9900u) << "LRW frames seen after OP";
+  EXPECT_GT(std::filesystem::file_size(dir_ / "soem_simple_test.pcap"), 100000u);
+  EXPECT_NE(readText(dir_ / "soem_simple_test.output.txt").find("End program"), std::string::npos);
+  expectNoNamespaceLeft();
+}
+
+// Through the command line, as CI runs it: the report, the JUnit file and the output next to it.
+TEST_F(ExternalScenario, SoemCableBreakThroughEcsimScenarioRun) {
+  ECSIM_REQUIRE_SOEM();
+  const auto junit = dir_ / "junit.xml";
+  const auto log = dir_ / "ecsim.log";
+  // SOEM_DIR reaches ${SOEM_DIR} through ecsim's environment.
+  auto child =
+      spawnProcess({"env", "SOEM_DIR=" + kSoem.string(), kEcsim, "scenario", "run", "--junit",
+                    junit.string(), (kSource / "scenarios/external/soem_cable_break.xml").string()},
+                   SpawnOptions{log.string(), log.string()});
+  ASSERT_TRUE(child.ok()) << child.error().message();
+  auto rc = child->wait(std::chrono::seconds(90));
+  const std::string out = readText(log);
+  std::cout << out;
+  ASSERT_TRUE(rc.ok()) << out;
+  EXPECT_EQ(*rc, 0) << out;
+  EXPECT_NE(out.find("link-down cable=drives"), std::string::npos) << out;
+  EXPECT_NE(out.find("result: soem_cable_break PASSED"), std::string::npos) << out;
+  EXPECT_NE(readText(junit).find("testsuite name=\"soem_cable_break\""), std::string::npos);
+  EXPECT_NE(readText(dir_ / "soem_cable_break.output.txt").find("ERROR : slave 5 lost"),
+            std::string::npos);
+  expectNoNamespaceLeft();
+}
+
+}  // namespace
+}  // namespace ecsim::scenario
