@@ -7,6 +7,9 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <csignal>
+#include <thread>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -131,6 +134,31 @@ TEST_F(ExternalScenario, ACommandStillRunningAtTheEndIsStopped) {
   EXPECT_TRUE(r.passed()) << formatReport(r);
   EXPECT_NE(formatReport(r).find("command stopped (stopped with SIGTERM)"), std::string::npos)
       << formatReport(r);
+  expectNoNamespaceLeft();
+}
+
+TEST_F(ExternalScenario, SigintStopsTheCommandAndRemovesTheNamespace) {
+  ECSIM_REQUIRE_NETWORK();
+  auto s = write("<Master kind=\"external\" timeZero=\"start\" command=\"sleep 30\"/>",
+                 "<ExitStatus value=\"0\"/>\n", "durationMs=\"60000\"");
+  // SIGINT to this process once the run is under way (its namespace exists, the command has
+  // been started a moment later), as Ctrl-C in a terminal would.
+  std::thread interrupter([] {
+    const std::string tag = "ecsim-" + std::to_string(::getpid()) + "-";
+    for (int i = 0; i < 500; ++i) {
+      auto list = runCommand({"ip", "netns", "list"});
+      if (list.ok() && list->output.find(tag) != std::string::npos) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    ::kill(::getpid(), SIGINT);
+  });
+  const auto before = std::chrono::steady_clock::now();
+  auto r = runExternalScenario(s);
+  interrupter.join();
+  EXPECT_LT(std::chrono::steady_clock::now() - before, std::chrono::seconds(10));
+  EXPECT_NE(r.error.find("interrupted by signal 2"), std::string::npos) << formatReport(r);
+  EXPECT_FALSE(r.passed());
   expectNoNamespaceLeft();
 }
 
