@@ -74,10 +74,13 @@ Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiDevice& device, std::st
   if (options.deviceModels) {
     devices::DeviceModelOptions modelOptions = options.models;
     if (!options.stateFile.empty()) modelOptions.stateFile = options.stateFile;
-    ECSIM_TRY(devices::attachDeviceModel(
-        *pd,
-        devices::deviceModelFor(sii.identity.vendorId, sii.identity.productCode, device.profileNo),
-        modelOptions));
+    const devices::DeviceModelKind kind =
+        devices::deviceModelFor(sii.identity.vendorId, sii.identity.productCode, device.profileNo);
+    ECSIM_TRY(devices::attachDeviceModel(*pd, kind, modelOptions));
+    // A power cycle re-creates the model as built here (plus what outlives the power).
+    pd->setRestart([kind, modelOptions](ProcessDataDevice& d) {
+      return devices::restartDeviceModel(d, kind, modelOptions);
+    });
   }
 
   auto slave =

@@ -175,4 +175,16 @@ void ProcessDataDevice::sync(Esc& esc, unsigned signal, AlState state, SimTime n
   if (exchanging) binding_.writeInputs(esc);
 }
 
+void ProcessDataDevice::powerUp() {
+  if (!od_->hasPowerUpValues()) od_->capturePowerUpValues();
+}
+
+Status ProcessDataDevice::coldStart() {
+  powerUp();  // switched off before the firmware ever ran: nothing to forget
+  od_->restorePowerUpValues();
+  bindStatus_ = binding_.bind(*od_, virtualSms_);
+  if (restart_) return restart_(*this);
+  return okStatus();
+}
+
 }  // namespace ecsim::slavesim

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -98,6 +99,11 @@ class Application {
 // and in SAFEOP and OP copies outputs -> dictionary, runs the application, copies dictionary
 // -> inputs. Outputs are copied in SAFEOP too (the values an application sees are the newest
 // the master sent); an application decides itself what SAFEOP means for its actuators.
+//
+// Power cycle (coldStart): the dictionary goes back to its power-up values, taken when the
+// firmware first ran (powerUp; so the values a builder or a topology <Input> set count as power-up
+// values; what the master wrote since does not), the binding follows the restored PDO
+// assignment and mapping, and the restart function, when set, re-creates the application.
 class ProcessDataDevice final : public Device {
  public:
   explicit ProcessDataDevice(std::shared_ptr<coe::ObjectDictionary> od);
@@ -105,6 +111,12 @@ class ProcessDataDevice final : public Device {
   void updateProfile(SlaveProfile& profile) override;
   void step(Esc& esc, AlState state, SimTime now) override;
   void sync(Esc& esc, unsigned signal, AlState state, SimTime now) override;
+  void powerUp() override;
+  Status coldStart() override;
+
+  // Re-creates the application after a power cycle (devices::restartDeviceModel).
+  using Restart = std::function<Status(ProcessDataDevice&)>;
+  void setRestart(Restart restart) { restart_ = std::move(restart); }
 
   coe::ObjectDictionary& dictionary() { return *od_; }
   std::shared_ptr<coe::ObjectDictionary> sharedDictionary() { return od_; }
@@ -126,6 +138,7 @@ class ProcessDataDevice final : public Device {
   Status bindStatus_;
   std::uint32_t virtualSms_{0};
   std::unique_ptr<Application> application_;
+  Restart restart_;
 };
 
 }  // namespace ecsim::slavesim

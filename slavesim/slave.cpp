@@ -13,11 +13,17 @@ void Slave::powerOn() {
   esc_.powerOnReset();
   powered_ = true;
   firmwareRunning_ = (esc_.reg16(reg::kDlStatus.address) & reg::dl_status::kPdiOperational) != 0;
+  started_ = true;  // the power-up state was taken at the first start (or is taken now)
+  coldStartStatus_ = device_ ? device_->coldStart() : okStatus();
 }
 
 void Slave::poll(SimTime now) {
   EscEvents events = esc_.takeEvents();
   if (!powered_ || !firmwareRunning_) return;
+  if (!started_) {
+    started_ = true;
+    if (device_) device_->powerUp();
+  }
   if (events.alControlWritten) {
     if (device_) device_->updateProfile(profile_);
     esm_.onAlControl(esc_, profile_);

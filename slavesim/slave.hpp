@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "protocol/result.hpp"
 #include "slavesim/al_state_machine.hpp"
 #include "slavesim/esc.hpp"
 
@@ -35,6 +36,12 @@ class Device {
   // Esc::syncActive(0) holds, a device synchronised to DC steps its model and latches its
   // inputs here rather than in step() (ETG.1020 DC synchronous mode, 0x1C32:01 = 2).
   virtual void sync(Esc& /*esc*/, unsigned /*signal*/, AlState /*state*/, SimTime /*now*/) {}
+  // Called once, when the firmware first runs (before it handles any event): the state the
+  // device is in now is its power-up state.
+  virtual void powerUp() {}
+  // Switched on again after a power cycle: back to the state after power-up, keeping only what
+  // the device keeps in non-volatile memory (Slave::powerOn).
+  virtual Status coldStart() { return okStatus(); }
 };
 
 class Slave {
@@ -63,14 +70,18 @@ class Slave {
   static constexpr unsigned kMaxSyncPulsesPerPoll = 4096;
 
   // Power. Off: the firmware stops (the topology breaks the links at the neighbours' ports).
-  // On: a power-on reset of the ESC (registers and AL state; the EEPROM content is kept); the
-  // firmware runs again only when the ESC loaded its EEPROM configuration (PDI operational),
-  // so a slave with an EEPROM checksum error stays in INIT. Device models keep their state:
-  // whoever owns them re-creates them for a cold start.
+  // On: a power-on reset of the ESC (registers and AL state; the EEPROM content is kept) and a
+  // cold start of the device (Device::coldStart: a dictionary-based slave's objects back to
+  // their power-up values, PDO assignment and mapping included, its device model re-created;
+  // what the device keeps in non-volatile memory, such as a multi-turn position or its state
+  // file, survives). The firmware runs again only when the ESC loaded its EEPROM configuration
+  // (PDI operational), so a slave with an EEPROM checksum error stays in INIT. A cold start
+  // that fails (a device model that cannot be re-created) is kept in coldStartStatus().
   void powerOff() { powered_ = false; }
   void powerOn();
   bool powered() const { return powered_; }
   bool firmwareRunning() const { return powered_ && firmwareRunning_; }
+  const Status& coldStartStatus() const { return coldStartStatus_; }
 
  private:
   std::string name_;
@@ -83,6 +94,8 @@ class Slave {
   std::uint64_t syncPulses_{0};
   bool powered_{true};
   bool firmwareRunning_{true};
+  bool started_{false};  // Device::powerUp called
+  Status coldStartStatus_;
 };
 
 }  // namespace ecsim::slavesim

@@ -101,6 +101,33 @@ FaultyMailbox& faultyMailbox(slavesim::Slave& slave) {
   return ref;
 }
 
+// An encoder terminal's fault (slavesim/devices/encoder_terminal.hpp): kind=data (default),
+// frame or power, on=0 clears, channel=N (default 1).
+Result<std::string> encoderFault(const FaultAction& a, slavesim::Slave& slave) {
+  auto& encoder = *slavesim::devices::encoderTerminalOf(slave);
+  ECSIM_ASSIGN_OR_RETURN(auto channel, a.number("channel", 1));
+  if (channel < 1 || channel > encoder.channels()) {
+    return a.error(fmt::format("{} has channels 1..{}", slave.name(), encoder.channels()));
+  }
+  ECSIM_ASSIGN_OR_RETURN(auto on, a.number("on", 1));
+  namespace ef = slavesim::devices::encoder_fault;
+  const std::string_view kind = a.get("kind").value_or("data");
+  std::uint8_t bit = ef::kData;
+  if (kind == "frame") {
+    bit = ef::kFrame;
+  } else if (kind == "power") {
+    bit = ef::kPower;
+  } else if (kind != "data") {
+    return a.error("kind must be data, frame or power");
+  }
+  const auto ch = static_cast<unsigned>(channel);
+  const std::uint8_t faults = on != 0 ? static_cast<std::uint8_t>(encoder.fault(ch) | bit)
+                                      : static_cast<std::uint8_t>(encoder.fault(ch) & ~bit);
+  encoder.setFault(ch, faults);
+  return fmt::format("{}: encoder channel {} {} {}", slave.name(), ch, kind,
+                     on != 0 ? "fault" : "fault cleared");
+}
+
 }  // namespace
 
 // ---- FaultAction ----------------------------------------------------------------------------
@@ -300,23 +327,13 @@ Result<std::string> FaultInjector::powerOff(std::size_t s) {
 
 Result<std::string> FaultInjector::powerOn(std::size_t s) {
   auto& slave = segment_.slave(s);
+  // Slave::powerOn also cold-starts the device: dictionary values back to power-up, the model
+  // re-created (a drive keeps its shaft angle and state file).
   slave.powerOn();
   poweredOff_.erase(s);
-  // A cold start of the device model: a drive saves its encoder state file and its successor
-  // reads it (slavesim/devices/device_models.hpp).
-  if (auto* pdd = dynamic_cast<slavesim::ProcessDataDevice*>(slave.device())) {
-    if (auto* drive = slavesim::devices::driveOf(slave)) {
-      slavesim::devices::DeviceModelOptions options;
-      options.drive = drive->params();
-      options.stateFile = drive->params().stateFile;
-      const auto kind = slavesim::devices::robotDriveOf(slave) != nullptr
-                            ? slavesim::devices::DeviceModelKind::kRobotDrive
-                            : slavesim::devices::DeviceModelKind::kCia402Drive;
-      if (auto st = slavesim::devices::attachDeviceModel(*pdd, kind, options); !st.ok()) {
-        return makeError(ErrorCode::kState,
-                         slave.name() + ": drive restart: " + st.error().context);
-      }
-    }
+  if (!slave.coldStartStatus().ok()) {
+    return makeError(ErrorCode::kState,
+                     slave.name() + ": device restart: " + slave.coldStartStatus().error().context);
   }
   for (unsigned p = 0; p < kPortCount; ++p) {
     const End end{s, p};
@@ -398,6 +415,8 @@ Result<std::string> FaultInjector::apply(const FaultAction& a, SimTime now) {
       di->setScript(static_cast<unsigned>(channel), *signal);
     } else if (auto* ai = slavesim::devices::analogInputsOf(slave)) {
       ai->setScript(static_cast<unsigned>(channel), *signal);
+    } else if (auto* enc = slavesim::devices::encoderTerminalOf(slave)) {
+      enc->setScript(static_cast<unsigned>(channel), *signal);  // shaft position in turns
     } else {
       return a.error(slave.name() + " has no scriptable inputs");
     }
@@ -460,9 +479,16 @@ Result<std::string> FaultInjector::apply(const FaultAction& a, SimTime now) {
     return fmt::format("{}: SDO {:#06x} aborted with {:#010x} ({})", slave.name(), objIndex, code,
                        sdoAbortText(static_cast<std::uint32_t>(code)));
   }
+  if (v == "encoder-fault") {
+    if (slavesim::devices::encoderTerminalOf(slave) != nullptr) return encoderFault(a, slave);
+  }
   if (v == "drive-fault" || v == "encoder-fault") {
     auto* drive = slavesim::devices::driveOf(slave);
-    if (drive == nullptr) return a.error(slave.name() + " is not a CiA 402 drive");
+    if (drive == nullptr) {
+      return a.error(slave.name() + (v == "encoder-fault"
+                                         ? " is neither an encoder terminal nor a CiA 402 drive"
+                                         : " is not a CiA 402 drive"));
+    }
     std::uint16_t code = kPositionSensorFault;
     if (v == "drive-fault") {
       ECSIM_ASSIGN_OR_RETURN(auto c, a.number("code", kOvercurrent));

@@ -9,14 +9,17 @@
 //   delay cable=C ns=N durationMs=T the cable takes N ns longer, each way, for T ms
 //   link-down|link-up cable=C | slave=S port=P
 //   power-off|power-on slave=S      off: a broken link at the neighbours' ports; on: power-on
-//                                   reset (registers, AL state; EEPROM and encoder state kept)
+//                                   reset (registers, AL state, dictionary values, device
+//                                   model; EEPROM and encoder position kept)
 //   al-error slave=S code=X [state=SAFEOP]   the firmware raises a local error
 //   eeprom-checksum slave=S         corrupts the SII checksum (word 7) and power-cycles
 //   mailbox-silent slave=S [on=0|1] the mailbox server stops (or resumes) answering
 //   sdo-abort slave=S index=X [sub=N] code=X  SDO requests for that object are aborted
 //   sdo-ok slave=S                  removes the SDO aborts
 //   drive-fault slave=S [code=X]    CiA 402 drive fault (default 0x2310 overcurrent)
-//   encoder-fault slave=S           drive fault 0x7305 (position sensor)
+//   encoder-fault slave=S [kind=data|frame|power] [on=0|1] [channel=N]
+//                                   an encoder terminal's fault (status bits, position
+//                                   frozen; on=0 clears it); on a drive: fault 0x7305
 //   input slave=S channel=N signal=TEXT    scripted input (slavesim/devices/signal.hpp)
 //
 // Random decisions come from a SplitMix64 generator seeded by the caller: the same seed and the

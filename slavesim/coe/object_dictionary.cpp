@@ -177,6 +177,28 @@ void ObjectDictionary::resetToDefaults() {
   }
 }
 
+void ObjectDictionary::capturePowerUpValues() {
+  powerUp_.clear();
+  for (const auto& [index, object] : objects_) {
+    for (const auto& e : object.entries) {
+      powerUp_[(static_cast<std::uint32_t>(index) << 8) | e.subindex] = e.value;
+    }
+  }
+}
+
+void ObjectDictionary::restorePowerUpValues() {
+  for (auto& [index, object] : objects_) {
+    for (auto& e : object.entries) {
+      auto it = powerUp_.find((static_cast<std::uint32_t>(index) << 8) | e.subindex);
+      const std::vector<std::uint8_t>& image = it != powerUp_.end() ? it->second : e.defaultValue;
+      // Sizes never change after insert(); copy what fits, zero the rest.
+      const std::size_t n = std::min(image.size(), e.value.size());
+      std::copy_n(image.begin(), n, e.value.begin());
+      std::fill(e.value.begin() + static_cast<std::ptrdiff_t>(n), e.value.end(), 0);
+    }
+  }
+}
+
 Object& ObjectDictionary::addVar(std::uint16_t index, std::string name, std::uint16_t dataType,
                                  std::uint16_t bitLength, std::uint16_t accessBits) {
   Object o;

@@ -129,6 +129,15 @@ class ObjectDictionary {
   // Every value back to its default.
   void resetToDefaults();
 
+  // Power-up values: what each entry holds when the device is switched on (ESI defaults plus
+  // what the builder and the device model set up). capturePowerUpValues() takes the current
+  // values as that image; restorePowerUpValues() writes it back (entries it does not cover,
+  // added later, get their default), as a power cycle does to everything a device does not
+  // keep in non-volatile memory. Objects and value sizes are left as they are.
+  void capturePowerUpValues();
+  void restorePowerUpValues();
+  bool hasPowerUpValues() const { return !powerUp_.empty(); }
+
   // ---- building -----------------------------------------------------------------------------
   // A VAR with its value at sub 0 (value zero, default zero).
   Object& addVar(std::uint16_t index, std::string name, std::uint16_t dataType,
@@ -153,6 +162,7 @@ class ObjectDictionary {
  private:
   std::map<std::uint16_t, Object> objects_;
   std::map<std::uint16_t, PdoRules> pdoRules_;
+  std::map<std::uint32_t, std::vector<std::uint8_t>> powerUp_;  // key: index << 8 | subindex
 };
 
 // ---- template definitions --------------------------------------------------------------------

@@ -122,6 +122,7 @@ class Cia402Drive : public Application {
   // (again after each fault reset, until cleared).
   void setEncoderFault(bool faulted) { encoder_.setFault(faulted); }
   void setEmergencySink(EmergencySink sink) { emergencySink_ = std::move(sink); }
+  const EmergencySink& emergencySink() const { return emergencySink_; }
   std::uint64_t emergenciesSent() const { return emergenciesSent_; }
   // Writes the state file now (no-op without one).
   Status saveState() const;

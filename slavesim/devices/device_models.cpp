@@ -17,6 +17,9 @@ constexpr std::uint32_t kProductDigitalOutputs = 0x00002008;
 constexpr std::uint32_t kProductAnalogInputs = 0x00003102;
 constexpr std::uint32_t kProductDrive = 0x00007201;
 constexpr std::uint32_t kProductRobotDrive = 0x00007211;
+constexpr std::uint32_t kProductSsiEncoder = 0x00005001;
+constexpr std::uint32_t kBeckhoffVendorId = 0x00000002;
+constexpr std::uint32_t kBeckhoffEj5002 = 0x138A2852;
 constexpr std::uint32_t kProfileDrive = 402;
 constexpr std::uint16_t kEncoderResolution = 0x2011;
 
@@ -53,6 +56,9 @@ Status applyScripts(Terminal& terminal, const std::vector<std::pair<unsigned, Si
 
 DeviceModelKind deviceModelFor(std::uint32_t vendorId, std::uint32_t productCode,
                                std::optional<std::uint32_t> profileNo) {
+  if (vendorId == kBeckhoffVendorId && productCode == kBeckhoffEj5002) {
+    return DeviceModelKind::kSsiEncoder;
+  }
   if (vendorId != kEcsimVendorId) return DeviceModelKind::kNone;
   switch (productCode) {
     case kProductDigitalInputs:
@@ -65,6 +71,8 @@ DeviceModelKind deviceModelFor(std::uint32_t vendorId, std::uint32_t productCode
       return DeviceModelKind::kCia402Drive;
     case kProductRobotDrive:
       return DeviceModelKind::kRobotDrive;
+    case kProductSsiEncoder:
+      return DeviceModelKind::kSsiEncoder;
     default:
       break;
   }
@@ -77,9 +85,9 @@ Status attachDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,
   device.setApplication(nullptr);  // the old model goes first (and saves its state)
   coe::ObjectDictionary& od = device.dictionary();
   if (!options.scripts.empty() && kind != DeviceModelKind::kDigitalInputs &&
-      kind != DeviceModelKind::kAnalogInputs) {
+      kind != DeviceModelKind::kAnalogInputs && kind != DeviceModelKind::kSsiEncoder) {
     return makeError(ErrorCode::kInvalidArgument,
-                     "input scripts (signal.N) need a digital or analog input terminal");
+                     "input scripts (signal.N) need an input terminal or an encoder");
   }
   DriveParams drive = options.drive;
   if (!options.stateFile.empty()) drive.stateFile = options.stateFile;
@@ -111,6 +119,48 @@ Status attachDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,
       return installDrive(device, Cia402Drive::create(od, drive), options.emergencies);
     case DeviceModelKind::kRobotDrive:
       return installDrive(device, RobotDrive::create(od, drive), options.emergencies);
+    case DeviceModelKind::kSsiEncoder: {
+      EncoderTerminalOptions encoder{drive.encoder, drive.initialShaftAngle, drive.stateFile};
+      ECSIM_ASSIGN_OR_RETURN(auto terminal, SsiEncoderTerminal::create(od, encoder));
+      ECSIM_TRY(applyScripts(*terminal, options.scripts));
+      device.setApplication(std::move(terminal));
+      return okStatus();
+    }
+  }
+  return okStatus();
+}
+
+Status restartDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,
+                          const DeviceModelOptions& options) {
+  DeviceModelOptions next = options;
+  Application* old = device.application();
+  if (auto* drive = dynamic_cast<Cia402Drive*>(old)) {
+    next.drive.initialShaftAngle = drive->axis().motor().angle();
+    if (!next.emergencies) next.emergencies = drive->emergencySink();
+  }
+  auto carryScripts = [&next](const auto& terminal) {
+    next.scripts.clear();
+    for (unsigned c = 1; c <= terminal.channels(); ++c) {
+      if (terminal.script(c)) next.scripts.emplace_back(c, *terminal.script(c));
+    }
+  };
+  if (auto* di = dynamic_cast<DigitalInputTerminal*>(old)) carryScripts(*di);
+  if (auto* ai = dynamic_cast<AnalogInputTerminal*>(old)) carryScripts(*ai);
+  std::vector<std::pair<double, std::uint8_t>> encoderChannels;  // shaft angle, faults
+  if (auto* enc = dynamic_cast<SsiEncoderTerminal*>(old)) {
+    carryScripts(*enc);
+    for (unsigned c = 1; c <= enc->channels(); ++c) {
+      encoderChannels.emplace_back(enc->shaftAngle(c), enc->fault(c));
+    }
+    if (!encoderChannels.empty()) next.drive.initialShaftAngle = encoderChannels.front().first;
+  }
+  ECSIM_TRY(attachDeviceModel(device, kind, next));
+  if (auto* enc = dynamic_cast<SsiEncoderTerminal*>(device.application())) {
+    for (unsigned c = 1; c <= encoderChannels.size() && c <= enc->channels(); ++c) {
+      // With a state file the new terminal read channel 1's angle from it: the same angle.
+      enc->setShaftAngle(c, encoderChannels[c - 1].first);
+      enc->setFault(c, encoderChannels[c - 1].second);
+    }
   }
   return okStatus();
 }
@@ -138,6 +188,10 @@ DigitalOutputTerminal* digitalOutputsOf(Slave& slave) {
 
 AnalogInputTerminal* analogInputsOf(Slave& slave) {
   return dynamic_cast<AnalogInputTerminal*>(deviceModelOf(slave));
+}
+
+SsiEncoderTerminal* encoderTerminalOf(Slave& slave) {
+  return dynamic_cast<SsiEncoderTerminal*>(deviceModelOf(slave));
 }
 
 // ---- parameters by name (device_params.hpp) ------------------------------------------------

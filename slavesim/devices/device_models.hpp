@@ -8,9 +8,11 @@
 //   ECS3102 (0x3102)            AnalogInputTerminal, 2 channels
 //   ECS7201 (0x7201)            Cia402Drive
 //   ECS7211 (0x7211)            RobotDrive
+//   ECS5001 (0x5001)            SsiEncoderTerminal (examples/esi/ecsim_encoders.xml)
 // for the ecsim vendor id (0x00000E5C); an ecsim device with CiA 402 profile (ProfileNo 402)
 // and another product code also gets a Cia402Drive. Devices of other vendors keep the plain
-// ProcessDataDevice: their dictionaries are theirs to define.
+// ProcessDataDevice (their dictionaries are theirs to define), except the Beckhoff EJ5002
+// (vendor 2, 0x138A2852), whose SSI channel layout the SsiEncoderTerminal follows.
 #pragma once
 
 #include <cstdint>
@@ -21,6 +23,7 @@
 
 #include "protocol/result.hpp"
 #include "slavesim/devices/cia402_drive.hpp"
+#include "slavesim/devices/encoder_terminal.hpp"
 #include "slavesim/devices/io_terminals.hpp"
 #include "slavesim/devices/robot_drive.hpp"
 #include "slavesim/process_data.hpp"
@@ -35,20 +38,24 @@ enum class DeviceModelKind : std::uint8_t {
   kAnalogInputs,
   kCia402Drive,
   kRobotDrive,
+  kSsiEncoder,
 };
 
 DeviceModelKind deviceModelFor(std::uint32_t vendorId, std::uint32_t productCode,
                                std::optional<std::uint32_t> profileNo = std::nullopt);
 
 struct DeviceModelOptions {
-  std::filesystem::path stateFile;  // drives: where the shaft position is kept
-  DriveParams drive;                // drives: motor, loops, encoder (stateFile above wins)
+  std::filesystem::path stateFile;  // drives, encoders: where the shaft position is kept
+  // Drives: motor, loops, encoder (stateFile above wins). Encoder terminals take its encoder
+  // and initialShaftAngle.
+  DriveParams drive;
   AnalogInputOptions analog;
   // drive.encoder.countsPerRevolution was chosen (and goes into 0x2011); otherwise a
   // dictionary with 0x2011 gives it.
   bool encoderResolutionSet{false};
   EmergencySink emergencies;  // drives: where their emergency messages go
-  // Input terminals: scripted channels (1-based; digital on at >= 0.5, analog in volts).
+  // Input terminals: scripted channels (1-based; digital on at >= 0.5, analog in volts,
+  // encoder shaft in turns).
   std::vector<std::pair<unsigned, Signal>> scripts;
 };
 
@@ -59,6 +66,15 @@ struct DeviceModelOptions {
 Status attachDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,
                          const DeviceModelOptions& options = {});
 
+// A cold start after a power cycle (ProcessDataDevice::setRestart): re-creates the model of
+// `kind` with `options`, carrying over what outlives the power: a drive's or an encoder's shaft
+// angle (the shaft stays where it is; with a state file the old model writes it and the new
+// reads it), a drive's emergency sink when `options` names none, input terminals' and
+// encoders' scripts (the signals come from outside the device) and encoder faults (wiring and
+// encoder supply are outside the terminal). Everything else starts as after power-up.
+Status restartDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,
+                          const DeviceModelOptions& options);
+
 // The model of a slave built by makeSlaveFromEsi (nullptr when it has another or none).
 Application* deviceModelOf(Slave& slave);
 Cia402Drive* driveOf(Slave& slave);  // also a RobotDrive
@@ -66,5 +82,6 @@ RobotDrive* robotDriveOf(Slave& slave);
 DigitalInputTerminal* digitalInputsOf(Slave& slave);
 DigitalOutputTerminal* digitalOutputsOf(Slave& slave);
 AnalogInputTerminal* analogInputsOf(Slave& slave);
+SsiEncoderTerminal* encoderTerminalOf(Slave& slave);
 
 }  // namespace ecsim::slavesim::devices

@@ -50,6 +50,10 @@ class DigitalInputTerminal final : public Application {
   void setScript(unsigned channel, Signal signal);
   void setInput(unsigned channel, bool on) { setScript(channel, Signal::constant(on ? 1 : 0)); }
   void clearScript(unsigned channel);
+  // The script of a channel (1-based), if it has one.
+  const std::optional<Signal>& script(unsigned channel) const {
+    return channels_.at(channel - 1).script;
+  }
   // The input as the dictionary (and so the next process-data image) holds it.
   bool input(unsigned channel) const;
 
@@ -116,6 +120,9 @@ class AnalogInputTerminal final : public Application {
   // Volts as a function of time.
   void setScript(unsigned channel, Signal volts);
   void clearScript(unsigned channel);
+  const std::optional<Signal>& script(unsigned channel) const {
+    return channels_.at(channel - 1).script;
+  }
   // The last converted (filtered) voltage of a scripted channel.
   double volts(unsigned channel) const;
   // Raw value for a voltage, as the ADC reports it (no filter).

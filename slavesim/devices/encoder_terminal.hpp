@@ -1,0 +1,113 @@
+// An SSI absolute encoder interface terminal: ecsim's ECS5001 (examples/esi/ecsim_encoders.xml)
+// and the real Beckhoff EJ5002, whose ESI (revision 0x00110000, TxPDOs 0x1A00/0x1A01 "SSI
+// Inputs Channel n") gives the layout both follow. Channel n (1-based) lives at
+// 0x6000 + 0x10 * (n - 1):
+//
+//   :01 Data error     no valid data from the encoder: a broken data line, an encoder that
+//                      does not answer the clock, or one without supply
+//   :02 Frame error    the SSI frame did not have the expected form
+//   :03 Power failure  the encoder's supply failed
+//   :0F TxPDO State    the inputs are invalid (any error above)
+//   :10 TxPDO Toggle   toggles with each new valid reading: it stands still while faulted
+//   :11 Counter value  the encoder's position (Encoder::read, reported value in 32 bits);
+//                      frozen at the last valid reading while an error is present
+// (:04 Data mismatch and :0E Sync error are laid out but never set.) Entries a dictionary
+// lacks (EJ5002 revision 0x00100000 keeps TxPDO state and toggle in 0x1800) are skipped.
+//
+// The shaft: each channel's encoder (encoder.hpp: resolution, single/multi-turn, noise) reads a
+// shaft angle that is either held (setShaftAngle, the topology's drive.initialShaftAngle) or
+// scripted in turns over time (signal.N, signal.hpp). An absolute multi-turn position survives
+// a power cycle: the restart keeps the shaft angle, and a state file keeps channel 1's angle
+// across restarts of the simulator (device_state.hpp), as for a drive.
+//
+// Faults (setFault, the scenario action `encoder-fault`) are conditions outside the terminal
+// (wiring, encoder supply): they stay until cleared, through a power cycle of the terminal;
+// when cleared, the next reading is valid again and the toggle resumes.
+//
+// The inputs are latched at each firmware step, or at SYNC0 while the ESC generates it: one new
+// reading (and one toggle) per point in simulation time.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "protocol/result.hpp"
+#include "slavesim/devices/encoder.hpp"
+#include "slavesim/devices/object_ref.hpp"
+#include "slavesim/devices/signal.hpp"
+#include "slavesim/process_data.hpp"
+
+namespace ecsim::slavesim::devices {
+
+// Bit mask of what is wrong on a channel.
+namespace encoder_fault {
+inline constexpr std::uint8_t kNone = 0;
+inline constexpr std::uint8_t kData = 1u << 0;   // no valid data (wire break)
+inline constexpr std::uint8_t kFrame = 1u << 1;  // malformed SSI frame
+inline constexpr std::uint8_t kPower = 1u << 2;  // encoder supply failed (no data either)
+}  // namespace encoder_fault
+
+struct EncoderTerminalOptions {
+  EncoderParams encoder;
+  double initialShaftAngle{0.0};    // rad, every channel, when there is no state file yet
+  std::filesystem::path stateFile;  // channel 1's shaft angle, kept across restarts
+};
+
+class SsiEncoderTerminal final : public Application {
+ public:
+  static constexpr std::uint16_t kInputBase = 0x6000;
+  static constexpr std::uint16_t kChannelStride = 0x10;
+  static constexpr unsigned kMaxChannels = 8;
+
+  // One channel per 0x6000 + 0x10 * n object with a counter value (:11); kNotFound when there
+  // is none, kParse when the state file is not one.
+  static Result<std::unique_ptr<SsiEncoderTerminal>> create(
+      coe::ObjectDictionary& od, const EncoderTerminalOptions& options = {});
+  ~SsiEncoderTerminal() override;
+  SsiEncoderTerminal(const SsiEncoderTerminal&) = delete;
+  SsiEncoderTerminal& operator=(const SsiEncoderTerminal&) = delete;
+
+  unsigned channels() const { return static_cast<unsigned>(channels_.size()); }
+  const EncoderTerminalOptions& options() const { return options_; }
+
+  // Channels are 1-based; calls for a channel the terminal does not have do nothing.
+  void setShaftAngle(unsigned channel, double rad);
+  double shaftAngle(unsigned channel) const;
+  void setScript(unsigned channel, Signal turns);
+  void clearScript(unsigned channel);
+  const std::optional<Signal>& script(unsigned channel) const {
+    return channels_.at(channel - 1).script;
+  }
+  void setFault(unsigned channel, std::uint8_t faults);
+  std::uint8_t fault(unsigned channel) const;
+  const Encoder& encoder(unsigned channel) const { return channels_.at(channel - 1).encoder; }
+
+  void step(coe::ObjectDictionary& od, AlState state, SimTime now) override;
+  void sync(coe::ObjectDictionary& od, unsigned signal, AlState state, SimTime now) override;
+
+  // Writes the state file now (no-op without one).
+  Status saveState() const;
+
+ private:
+  struct Channel {
+    explicit Channel(const EncoderParams& p) : encoder(p) {}
+    Encoder encoder;
+    ObjectRef dataError, frameError, powerFailure, txPdoState, txPdoToggle, counter;
+    std::optional<Signal> script;
+    double angle{0.0};
+    std::uint8_t faults{encoder_fault::kNone};
+    bool toggle{false};
+  };
+  explicit SsiEncoderTerminal(const EncoderTerminalOptions& options) : options_(options) {}
+  void latch(SimTime now);
+
+  EncoderTerminalOptions options_;
+  std::vector<Channel> channels_;
+  SimTime lastLatch_{0};
+  bool latched_{false};
+};
+
+}  // namespace ecsim::slavesim::devices
