@@ -81,7 +81,8 @@ bool MasterHealth::allOperational() const {
 
 HealthMonitor::HealthMonitor(Transport& transport, std::vector<SlaveInfo>& slaves,
                              const ProcessImageLayout& layout, CyclicExchange& cyclic,
-                             bool recovery, HealthOptions options, StateChangeOptions state)
+                             bool recovery, HealthOptions options, StateChangeOptions state,
+                             std::unique_ptr<SlaveSetup> setup, MailboxOptions mailbox)
     : transport_(transport),
       slaveInfos_(slaves),
       layout_(layout),
@@ -89,6 +90,8 @@ HealthMonitor::HealthMonitor(Transport& transport, std::vector<SlaveInfo>& slave
       recovery_(recovery),
       options_(options),
       state_(state),
+      setup_(std::move(setup)),
+      mailbox_(mailbox),
       slaves_(slaves.size()) {
   for (std::size_t i = 0; i < slaves.size(); ++i) {
     SlaveHealth& h = slaves_[i].health;
@@ -140,12 +143,20 @@ void HealthMonitor::afterCycle(const CycleResult& result, std::uint64_t cycle, S
       w.health.condition = SlaveCondition::kOperational;
       ++w.health.recoveredCount;
       ++slavesRecovered_;
+      w.lastFailure.clear();
       event(MasterEventKind::kSlaveRecovered, i, cycle, now, "back in OP");
     } else {
+      // Tried again every retryAfter cycles; reported once per reason, not at every attempt.
       w.health.condition = SlaveCondition::kFailed;
+      ++w.health.failedAttempts;
       w.retryAt = cycle + options_.retryAfter;
-      event(MasterEventKind::kRecoveryFailed, i, cycle, now,
-            "not recovered (" + w.recovery->status().error().context + ")");
+      const std::string& reason = w.recovery->status().error().context;
+      if (reason != w.lastFailure) {
+        w.lastFailure = reason;
+        event(MasterEventKind::kRecoveryFailed, i, cycle, now,
+              "not recovered: " + reason + "; tried again every " +
+                  std::to_string(options_.retryAfter) + " cycles");
+      }
     }
     w.misses = 0;
     w.recovery.reset();
@@ -217,8 +228,20 @@ void HealthMonitor::takeStatusReads(std::uint64_t cycle, SimTime now) {
           changed = true;
           break;
         case SlaveCondition::kFailed:
+          // Another attempt, without a new event: it says something when it succeeds or fails
+          // for another reason.
           if (cycle < w.retryAt) break;
-          [[fallthrough]];
+          if (inOp) {
+            w.health.condition = SlaveCondition::kOperational;
+            ++w.health.recoveredCount;
+            ++slavesRecovered_;
+            w.lastFailure.clear();
+            event(MasterEventKind::kSlaveRecovered, i, cycle, now, "back in OP");
+          } else {
+            startRecovery(i, firstStage(info), now);
+          }
+          changed = true;
+          break;
         case SlaveCondition::kLost:
           event(MasterEventKind::kSlaveReturned, i, cycle, now,
                 "answers again (" + describeAlStatus(info.alStatus) + ")");
@@ -275,8 +298,8 @@ void HealthMonitor::startRecovery(std::size_t position, SlaveRecoveryTask::Stage
                                   SimTime now) {
   Watch& w = slaves_[position];
   w.health.condition = SlaveCondition::kRecovering;
-  w.recovery =
-      std::make_unique<SlaveRecoveryTask>(transport_, slaveInfos_[position], layout_, state_);
+  w.recovery = std::make_unique<SlaveRecoveryTask>(transport_, slaveInfos_[position], layout_,
+                                                   state_, setup_.get(), mailbox_);
   w.recovery->start(first, now, options_.recoveryTimeout);
 }
 

@@ -15,6 +15,10 @@
 //             there, both are accepted
 //   error     a slave that shows an AL error or a state below OP (an SM watchdog, 0x001B, took
 //             it to SAFEOP+ERROR) is acknowledged and brought back to OP the same way
+//   failed    a recovery that fails (another device, an EEPROM checksum error, a mailbox that
+//             does not answer, an SDO abort) is reported with its reason and tried again every
+//             `retryAfter` cycles; a retry that fails for the same reason is not reported again
+//             (SlaveHealth::failedAttempts counts them), one that succeeds is "back in OP"
 //
 // With MasterOptions::recovery false the monitor only counts: nothing is read, nothing is
 // reconfigured, and every missing working counter is a WKC error.
@@ -60,7 +64,8 @@ struct SlaveHealth {
   std::uint16_t alStatusCode{0};
   std::uint64_t lostCount{0};
   std::uint64_t recoveredCount{0};
-  std::uint64_t errorCount{0};  // AL errors seen while it answered
+  std::uint64_t errorCount{0};      // AL errors seen while it answered
+  std::uint64_t failedAttempts{0};  // recoveries that failed (each retry counts)
   std::uint64_t lastEventCycle{0};
 };
 
@@ -97,9 +102,12 @@ struct MasterEvent {
 class HealthMonitor {
  public:
   // All references must outlive the monitor; `layout` is the one `cyclic` was built from.
+  // `setup` says what a recovered slave is given besides its mailbox and process-data SMs and
+  // FMMUs (null: nothing; the Master gives a MasterSlaveSetup).
   HealthMonitor(Transport& transport, std::vector<SlaveInfo>& slaves,
                 const ProcessImageLayout& layout, CyclicExchange& cyclic, bool recovery,
-                HealthOptions options = {}, StateChangeOptions state = {});
+                HealthOptions options = {}, StateChangeOptions state = {},
+                std::unique_ptr<SlaveSetup> setup = nullptr, MailboxOptions mailbox = {});
 
   // After each finished cycle (`cycle` counts from 1). Queues datagrams, steps recoveries;
   // never blocks.
@@ -117,6 +125,7 @@ class HealthMonitor {
     SlaveHealth health;
     unsigned misses{0};
     std::uint64_t retryAt{0};
+    std::string lastFailure;  // the reason last reported
     std::unique_ptr<SlaveRecoveryTask> recovery;
   };
 
@@ -135,6 +144,8 @@ class HealthMonitor {
   bool recovery_;
   HealthOptions options_;
   StateChangeOptions state_;
+  std::unique_ptr<SlaveSetup> setup_;
+  MailboxOptions mailbox_;
   std::vector<Watch> slaves_;
   DatagramBatch reads_;  // one per slave, made once; the first readPositions_.size() in use
   bool readsOut_{false};

@@ -234,8 +234,9 @@ Status Master::configureProcessData() {
   image_.assign(layout_.size(), 0);
   ECSIM_TRY(cyclic_.build(layout_, options_.transport.source));
   cyclic_.setTiming(options_.cycleTime, options_.cycleTime);
-  health_ = std::make_unique<HealthMonitor>(transport_, slaves_, layout_, cyclic_,
-                                            options_.recovery, options_.health, options_.state);
+  health_ = std::make_unique<HealthMonitor>(
+      transport_, slaves_, layout_, cyclic_, options_.recovery, options_.health, options_.state,
+      std::make_unique<MasterSlaveSetup>(processData_, config_), options_.mailbox);
   std::vector<std::string> names;  // the configuration's names, else the SII's
   if (config_) {
     for (const auto& expected : config_->slaves) names.push_back(expected.name);

@@ -11,9 +11,122 @@ namespace {
 constexpr std::uint16_t kEepromReadLength = static_cast<std::uint16_t>(
     reg::kSiiData.address + reg::kSiiData.width - reg::kSiiControlStatus.address);
 constexpr std::size_t kEepromDataOffset = reg::kSiiData.address - reg::kSiiControlStatus.address;
-constexpr std::size_t kIdentityBytes = 8;  // vendor id, product code
+constexpr std::size_t kIdentityBytes = 8;             // vendor id, product code
+constexpr std::uint16_t kPdoAssignmentBase = 0x1C10;  // + SM number
+
+std::string hex(unsigned v, int digits) {
+  static constexpr char kDigits[] = "0123456789ABCDEF";
+  std::string s = "0x";
+  for (int d = digits - 1; d >= 0; --d) s += kDigits[(v >> (4 * d)) & 0xF];
+  return s;
+}
+
+SetupWrite sdoWrite(std::uint16_t index, std::uint8_t subindex, std::vector<std::uint8_t> data) {
+  SetupWrite w;
+  w.kind = SetupWrite::Kind::kSdo;
+  w.index = index;
+  w.subindex = subindex;
+  w.data = std::move(data);
+  w.what = "PDO assignment " + hex(index, 4) + ":" + hex(subindex, 2).substr(2);
+  return w;
+}
 
 }  // namespace
+
+std::vector<SetupWrite> pdoAssignmentWrites(const SlaveProcessData& data) {
+  std::vector<SetupWrite> writes;
+  if (data.source != PdoSource::kCoe) return writes;
+  for (const SmPdoAssignment& sm : data.sms) {
+    const auto index = static_cast<std::uint16_t>(kPdoAssignmentBase + sm.sm);
+    writes.push_back(sdoWrite(index, 0, {0}));
+    std::uint8_t sub = 0;
+    for (const PdoInfo& pdo : sm.pdos) {
+      std::vector<std::uint8_t> value(2);
+      writeLe16(value, 0, pdo.index);
+      writes.push_back(sdoWrite(index, ++sub, std::move(value)));
+    }
+    writes.push_back(sdoWrite(index, 0, {sub}));
+  }
+  return writes;
+}
+
+namespace {
+
+bool isWrite(Command c) {
+  return c == Command::kApwr || c == Command::kFpwr || c == Command::kBwr || c == Command::kAprw ||
+         c == Command::kFprw || c == Command::kBrw;
+}
+
+// An ENI's init commands of one slave for from -> to: register writes (at the slave's station
+// address; AL control and the station address are the recovery's own) and CoE downloads.
+void addEniWrites(std::vector<SetupWrite>& out, const EniConfig& eni, const EniSlave& slave,
+                  char from, char to, bool registers, bool coe) {
+  const std::string transition{from, to};
+  if (registers) {
+    for (const EniRegisterCmd& c : slave.initCmds) {
+      if (c.ado == reg::kAlControl.address || c.ado == reg::kConfiguredStationAddress.address) {
+        continue;
+      }
+      if (!isWrite(static_cast<Command>(c.cmd)) || c.data.empty()) continue;
+      // addEniRegisterCmds() decides which transitions a command belongs to: ask it.
+      EniSlave one;
+      one.initCmds.push_back(c);
+      DatagramBatch probe;
+      if (addEniRegisterCmds(probe, one, from, to) == 0) continue;
+      SetupWrite w;
+      w.kind = SetupWrite::Kind::kRegister;
+      w.index = c.ado;
+      w.data = c.data;
+      w.what = "register init command " + hex(c.ado, 4) + " (" + transition + "), " +
+               eni.file.string() + " line " + std::to_string(c.line);
+      out.push_back(std::move(w));
+    }
+  }
+  if (coe) {
+    for (const EniCoeCmd* c : eniCoeCmds(slave, from, to)) {
+      if (c->ccs != 1) continue;  // uploads only read
+      SetupWrite w;
+      w.kind = SetupWrite::Kind::kSdo;
+      w.index = c->index;
+      w.subindex = c->subIndex;
+      w.completeAccess = c->completeAccess;
+      w.data = c->data;
+      w.what = "CoE init command " + hex(c->index, 4) + ":" + std::to_string(c->subIndex) + " (" +
+               transition + "), " + eni.file.string() + " line " + std::to_string(c->line);
+      out.push_back(std::move(w));
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<SetupWrite> MasterSlaveSetup::writesFor(const SlaveInfo& slave, AlState target) const {
+  std::vector<SetupWrite> out;
+  if (config_ && config_->eni && slave.position < config_->eni->slaves.size()) {
+    const EniConfig& eni = *config_->eni;
+    const EniSlave& want = eni.slaves[slave.position];
+    switch (target) {
+      case AlState::kPreOp:
+        addEniWrites(out, eni, want, 'I', 'P', true, false);
+        break;
+      case AlState::kSafeOp:
+        addEniWrites(out, eni, want, 'I', 'P', false, true);  // a mailbox exists from PREOP on
+        addEniWrites(out, eni, want, 'P', 'S', true, true);
+        break;
+      case AlState::kOp:
+        addEniWrites(out, eni, want, 'S', 'O', true, true);
+        break;
+      case AlState::kInit:
+      case AlState::kBootstrap:
+        break;
+    }
+    return out;
+  }
+  if (target == AlState::kSafeOp && slave.position < processData_.size()) {
+    out = pdoAssignmentWrites(processData_[slave.position]);
+  }
+  return out;
+}
 
 std::string_view toString(SlaveRecoveryTask::Stage stage) {
   switch (stage) {
@@ -36,8 +149,14 @@ std::string_view toString(SlaveRecoveryTask::Stage stage) {
 }
 
 SlaveRecoveryTask::SlaveRecoveryTask(Transport& transport, SlaveInfo& slave,
-                                     const ProcessImageLayout& layout, StateChangeOptions options)
-    : transport_(transport), slave_(slave), layout_(layout), options_(options) {}
+                                     const ProcessImageLayout& layout, StateChangeOptions options,
+                                     const SlaveSetup* setup, MailboxOptions mailbox)
+    : transport_(transport),
+      slave_(slave),
+      layout_(layout),
+      options_(options),
+      setup_(setup),
+      mailbox_(mailbox) {}
 
 void SlaveRecoveryTask::start(Stage first, SimTime now, SimTime timeout) {
   status_ = okStatus();
@@ -47,15 +166,17 @@ void SlaveRecoveryTask::start(Stage first, SimTime now, SimTime timeout) {
 
 std::optional<SimTime> SlaveRecoveryTask::wakeAt() const {
   if (change_) return change_->wakeAt();
+  if (sdo_) return sdo_->wakeAt();
   return std::nullopt;
 }
 
 void SlaveRecoveryTask::fail(Status status) {
-  status_ = makeError(status.error().code, slave_.label() + " recovery (" +
-                                               std::string(toString(stage_)) +
+  // The event that reports it names the slave.
+  status_ = makeError(status.error().code, "recovery (" + std::string(toString(stage_)) +
                                                "): " + status.error().context);
   stage_ = Stage::kFailed;
   change_.reset();
+  sdo_.reset();
 }
 
 void SlaveRecoveryTask::enter(Stage stage, SimTime now) {
@@ -63,6 +184,8 @@ void SlaveRecoveryTask::enter(Stage stage, SimTime now) {
   sub_ = Sub::kStart;
   batch_.clear();
   change_.reset();
+  sdo_.reset();
+  writes_.clear();
   switch (stage) {
     case Stage::kAddress: {
       std::array<std::uint8_t, 2> station{};
@@ -84,14 +207,11 @@ void SlaveRecoveryTask::enter(Stage stage, SimTime now) {
       addMailboxSetup(batch_, slave_);
       break;
     case Stage::kProcess:
-      for (const auto& sl : layout_.slaves) {
-        if (sl.position != slave_.position) continue;
-        ProcessImageLayout mine;
-        mine.slaves.push_back(sl);
-        addProcessDataSetup(batch_, mine);
-      }
-      break;
+      startWrites(AlState::kSafeOp);  // then the SMs and FMMUs (queueProcessDataSetup)
+      return;
     case Stage::kOp:
+      startWrites(AlState::kOp);
+      return;
     case Stage::kDone:
     case Stage::kFailed:
       break;
@@ -99,6 +219,62 @@ void SlaveRecoveryTask::enter(Stage stage, SimTime now) {
   (void)now;
   batch_.queueAll(transport_);
   sub_ = Sub::kWait;
+}
+
+void SlaveRecoveryTask::queueProcessDataSetup() {
+  batch_.clear();
+  for (const auto& sl : layout_.slaves) {
+    if (sl.position != slave_.position) continue;
+    ProcessImageLayout mine;
+    mine.slaves.push_back(sl);
+    addProcessDataSetup(batch_, mine);
+  }
+  batch_.queueAll(transport_);
+  sub_ = Sub::kWait;
+}
+
+void SlaveRecoveryTask::startWrites(AlState target) {
+  writes_.clear();
+  if (setup_ != nullptr) writes_ = setup_->writesFor(slave_, target);
+  write_ = 0;
+  writeQueued_ = false;
+  sdo_.reset();
+  sub_ = Sub::kWrites;
+}
+
+// One write after the other; false when all are done or one failed (stage_ says which).
+bool SlaveRecoveryTask::stepWrites(SimTime now) {
+  while (write_ < writes_.size()) {
+    const SetupWrite& w = writes_[write_];
+    Status done = okStatus();
+    if (w.kind == SetupWrite::Kind::kSdo) {
+      if (!sdo_) {
+        sdo_ = std::make_unique<SdoTask>(transport_, slave_, nullptr, mailbox_);
+        done = sdo_->startDownload(w.index, w.subindex, w.data, w.completeAccess, now);
+      }
+      if (done.ok()) {
+        if (sdo_->step(now)) return true;
+        done = sdo_->status();
+      }
+      sdo_.reset();
+    } else {
+      if (!writeQueued_) {
+        batch_.clear();
+        batch_.add().fpwr(slave_.station, w.index, w.data);
+        batch_.queueAll(transport_);
+        writeQueued_ = true;
+      }
+      if (batch_.pending()) return true;
+      writeQueued_ = false;
+      done = batch_.check();
+    }
+    if (!done.ok()) {
+      fail(makeError(done.error().code, w.what + ": " + done.error().context));
+      return false;
+    }
+    ++write_;
+  }
+  return false;
 }
 
 void SlaveRecoveryTask::queueEepromRead(std::uint32_t word) {
@@ -146,9 +322,15 @@ bool SlaveRecoveryTask::stepIdentity(SimTime now) {
       queueEepromRead(eepromWord_ + static_cast<std::uint32_t>(n / 2));
       return true;
     }
-    if ((status & reg::sii::kErrorMask) != 0) {
+    if ((status & reg::sii::kChecksumError) != 0) {
       fail(makeError(ErrorCode::kIo,
-                     "EEPROM read of word " + std::to_string(eepromWord_) + " reports error bits"));
+                     "EEPROM checksum error (0x0502 bit 11): the ESC did not load its "
+                     "configuration, the slave cannot leave INIT"));
+      return false;
+    }
+    if ((status & reg::sii::kErrorMask) != 0) {
+      fail(makeError(ErrorCode::kIo, "EEPROM read of word " + std::to_string(eepromWord_) +
+                                         " reports error bits (0x0502 = " + hex(status, 4) + ")"));
       return false;
     }
   }
@@ -201,27 +383,37 @@ bool SlaveRecoveryTask::step(SimTime now) {
       return true;
     case Stage::kIdentity:
       return stepIdentity(now);
-    case Stage::kMailbox:
+    case Stage::kMailbox:  // SMs, writes, PREOP
+    case Stage::kProcess:  // writes, SMs and FMMUs, SAFEOP
       if (sub_ == Sub::kWait) {
         if (batch_.pending()) return true;
         if (auto s = batch_.check(); !s.ok()) {
           fail(s);
           return false;
         }
-        sub_ = Sub::kStart;
+        if (stage_ == Stage::kMailbox) {
+          startWrites(AlState::kPreOp);
+        } else {
+          sub_ = Sub::kStart;
+        }
       }
-      return stepStateChange(AlState::kPreOp, Stage::kProcess, now);
-    case Stage::kProcess:
-      if (sub_ == Sub::kWait) {
-        if (batch_.pending()) return true;
-        if (auto s = batch_.check(); !s.ok()) {
-          fail(s);
-          return false;
+      if (sub_ == Sub::kWrites) {
+        if (stepWrites(now)) return true;
+        if (stage_ == Stage::kFailed) return false;
+        if (stage_ == Stage::kProcess) {
+          queueProcessDataSetup();
+          return true;
         }
         sub_ = Sub::kStart;
       }
-      return stepStateChange(AlState::kSafeOp, Stage::kOp, now);
+      return stage_ == Stage::kMailbox ? stepStateChange(AlState::kPreOp, Stage::kProcess, now)
+                                       : stepStateChange(AlState::kSafeOp, Stage::kOp, now);
     case Stage::kOp:
+      if (sub_ == Sub::kWrites) {
+        if (stepWrites(now)) return true;
+        if (stage_ == Stage::kFailed) return false;
+        sub_ = Sub::kStart;
+      }
       return stepStateChange(AlState::kOp, Stage::kDone, now);
     case Stage::kDone:
     case Stage::kFailed:

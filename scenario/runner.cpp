@@ -22,8 +22,6 @@
 namespace ecsim::scenario {
 namespace {
 
-constexpr std::uint64_t kStatusInterval = 100;  // cycles between routine AL status reads
-
 std::string ms(SimTime t) {
   return fmt::format("{:.3f} ms", static_cast<double>(t) / static_cast<double>(kNsPerMs));
 }
@@ -44,11 +42,35 @@ std::string number(double v) {
   return fmt::format("{:.6g}", v);
 }
 
-// What the master observed in one cycle (or in the diagnosis after it).
+// The condition a master event is matched as by <Detected condition="...">.
+std::string_view conditionOf(master::MasterEventKind kind) {
+  switch (kind) {
+    case master::MasterEventKind::kSlaveLost:
+      return "slave-lost";
+    case master::MasterEventKind::kSlaveReturned:
+      return "slave-returned";
+    case master::MasterEventKind::kSlaveReset:
+      return "slave-reset";
+    case master::MasterEventKind::kSlaveError:
+      return "slave-state";
+    case master::MasterEventKind::kSlaveRecovered:
+      return "slave-recovered";
+    case master::MasterEventKind::kRecoveryFailed:
+      return "recovery-failed";
+  }
+  return "?";
+}
+
+// Conditions that are not an error (any-error does not match them).
+bool isGoodNews(std::string_view condition) {
+  return condition == "slave-returned" || condition == "slave-recovered";
+}
+
+// What the master observed in one cycle: its cycle result and its events.
 struct Observation {
   std::uint64_t cycle{0};
   SimTime time{0};
-  std::string condition;  // wkc-error, frame-lost, slave-state, slave-lost, emergency
+  std::string condition;  // wkc-error, frame-lost, emergency, or conditionOf() an event
   std::set<std::string> slaves;
   std::string text;
 };
@@ -64,7 +86,9 @@ class Run {
   void learnStations();
   void observe(std::uint64_t cycle, const std::string& condition, std::set<std::string> slaves,
                const std::string& text);
-  void diagnoseAndRecover(std::uint64_t cycle, bool broken);
+  void takeEvents(std::uint64_t cycle);
+  bool cleanCycle() const;
+  std::optional<double> healthStatistic(const Expectation& x) const;
   bool allOp() const;
   void checkTimed(std::uint64_t cycle, bool atEnd);
   ExpectationResult evaluatePoint(const Expectation& x);
@@ -83,8 +107,7 @@ class Run {
   std::uint64_t badCycles_{0};
   std::uint64_t run_{0};
   std::uint64_t longestRun_{0};
-  std::uint64_t recoveries_{0};
-  SimTime nextRecovery_{0};
+  std::size_t eventsSeen_{0};
   std::size_t emergenciesSeen_{0};
   std::map<std::string, std::pair<std::uint64_t, std::string>> lastLogged_;
   std::map<std::uint16_t, std::string> stationNames_;
@@ -97,8 +120,8 @@ std::string Run::slaveNameAtPosition(std::size_t position) const {
   return it == stationNames_.end() ? fmt::format("position {}", position) : it->second;
 }
 
-// Which simulated slave got which station address (taken after each successful start, as a
-// power cycle clears the address in the ESC).
+// Which simulated slave got which station address (taken once the master is in OP: a power
+// cycle clears the address in the ESC until the master's recovery writes it again).
 void Run::learnStations() {
   auto& seg = *network_.segment;
   for (std::size_t i = 0; i < seg.size(); ++i) {
@@ -126,57 +149,46 @@ bool Run::allOp() const {
   return master_->slaves().size() == seg.size();
 }
 
-// The application's part until the master recovers by itself: read every slave's state (this
-// is how lost slaves and state changes are reported) and restart the bus when needed.
-void Run::diagnoseAndRecover(std::uint64_t cycle, bool broken) {
-  if (clock_.now() < nextRecovery_) return;
-  nextRecovery_ = clock_.now() + o_.recoveryInterval;
-  auto states = master_->readStates();
-  if (!states.ok()) {
-    // The error names the stations that did not answer ("FPRD 0x1005:0x0130 ...").
-    std::set<std::string> names;
-    for (std::size_t p = 0; p < master_->slaves().size(); ++p) {
-      const auto tag = fmt::format("{:#06x}:", master_->slaves()[p].station);
-      if (states.error().context.find(tag) != std::string::npos) {
-        names.insert(slaveNameAtPosition(p));
-      }
-    }
-    observe(cycle, "slave-lost", names, "slave(s) not answering: " + states.error().context);
+// Every slave in OP (simulator side) and the master exchanging with every one of them: none
+// lost, recovering or failed in its health.
+bool Run::cleanCycle() const {
+  if (!allOp()) return false;
+  const auto health = master_->health();
+  return health.slaves.size() == network_.segment->size() && health.allOperational();
+}
+
+// The master's events since the last call, as observations: what a master reports is what the
+// scenario is judged by.
+void Run::takeEvents(std::uint64_t cycle) {
+  const auto& events = master_->events();
+  for (; eventsSeen_ < events.size(); ++eventsSeen_) {
+    const master::MasterEvent& e = events[eventsSeen_];
+    std::string text = e.text;  // "slave 3 (0x1004 'AI1') lost at cycle 1002": the master's count
+    if (auto at = text.rfind(" at cycle "); at != std::string::npos) text.erase(at);
+    observe(cycle, std::string(conditionOf(e.kind)), {slaveNameAtPosition(e.position)}, text);
   }
-  // A frame lost now and then needs no restart; a slave missing, out of OP or a working
-  // counter that differs (a slave more or less on the bus) does.
-  bool restart =
-      broken || !states.ok() || master_->lastCycle().wkcErrors > 0 || master_->slaves().empty();
-  for (std::size_t p = 0; p < master_->slaves().size(); ++p) {
-    const auto& info = master_->slaves()[p];
-    if (info.state() && *info.state() != AlState::kOp) {
-      restart = true;
-      observe(
-          cycle, "slave-state", {slaveNameAtPosition(p)},
-          fmt::format("slave {} '{}' in {}", p, slaveNameAtPosition(p), toString(*info.state())));
-    }
+}
+
+// Master health figures, and how often the master reported a condition (Detected's names),
+// of one slave when the expectation names one.
+std::optional<double> Run::healthStatistic(const Expectation& x) const {
+  if (x.name == "slavesLost" || x.name == "slavesRecovered" || x.name == "framesLate") {
+    const auto h = master_->health();
+    if (x.name == "slavesLost") return static_cast<double>(h.slavesLost);
+    if (x.name == "slavesRecovered") return static_cast<double>(h.slavesRecovered);
+    return static_cast<double>(h.framesLate);
   }
-  if (!restart && states.ok()) {
-    // A slave that came back (power on, cable plugged in) has no station address yet and
-    // adds nothing to the cyclic working counters: count the slaves with a broadcast read.
-    master::DatagramBatch batch;
-    batch.add().prepare(Command::kBrd, DatagramHeader::physical(0, 0x0130), 2,
-                        static_cast<std::uint16_t>(master_->slaves().size()));
-    batch.queueAll(master_->transport());
-    master::BatchWait wait(batch);
-    (void)master::runTask(wait, master_->transport(), master_->bus(), 10 * kNsPerMs, "slave count");
-    if (auto c = batch.check(); !c.ok()) {
-      observe(cycle, "slave-count", {}, "slave count changed: " + c.error().context);
-      restart = true;
-    }
+  static constexpr std::string_view kConditions[] = {
+      "wkc-error",   "frame-lost",  "emergency",       "slave-lost",     "slave-returned",
+      "slave-reset", "slave-state", "slave-recovered", "recovery-failed"};
+  if (std::find(std::begin(kConditions), std::end(kConditions), x.name) == std::end(kConditions)) {
+    return std::nullopt;
   }
-  if (!restart) return;
-  ++recoveries_;
-  auto started = master_->start();
-  if (started.ok()) learnStations();
-  r_.log.push_back(fmt::format(
-      "{:>12}  cycle {:>6}  recovery: restart {}", ms(sinceOp()), cycle,
-      started.ok() ? std::string("ok, all slaves in OP") : "failed: " + started.error().context));
+  std::size_t n = 0;
+  for (const auto& o : observations_) {
+    if (o.condition == x.name && (x.slave.empty() || o.slaves.count(x.slave) > 0)) ++n;
+  }
+  return static_cast<double>(n);
 }
 
 ExpectationResult Run::evaluatePoint(const Expectation& x) {
@@ -224,9 +236,9 @@ ExpectationResult Run::evaluatePoint(const Expectation& x) {
       if (x.name == "cyclesWithErrors") v = static_cast<double>(st.cyclesWithErrors);
       if (x.name == "cycles") v = static_cast<double>(st.cycles);
       if (x.name == "badCycles") v = static_cast<double>(badCycles_);
-      if (x.name == "recoveries") v = static_cast<double>(recoveries_);
       if (x.name == "emergencies") v = static_cast<double>(master_->emergencies().size());
       if (x.name == "framesCorrupted") v = static_cast<double>(faults_->framesCorrupted());
+      if (auto h = healthStatistic(x)) v = h;
       if (!v) {
         res.observed = "unknown statistic '" + x.name + "'";
         break;
@@ -300,7 +312,8 @@ void Run::evaluateWindows() {
       std::vector<std::string> seen;
       for (const auto& o : observations_) {
         if (o.cycle < x.afterCycle) continue;
-        const bool match = (x.condition == "any-error" || o.condition == x.condition) &&
+        const bool match = ((x.condition == "any-error" && !isGoodNews(o.condition)) ||
+                            o.condition == x.condition) &&
                            (x.slave.empty() || o.slaves.count(x.slave) > 0);
         if (match && o.cycle <= last) {
           res.passed = true;
@@ -408,6 +421,7 @@ ScenarioResult Run::execute() {
   });
   master::MasterOptions mo;
   mo.cycleTime = s_.cycleTime;
+  mo.recovery = o_.recovery;
   master_ = std::make_unique<master::Master>(masterEnd, bus, mo);
   struct ResetFirst {  // the master goes before the link and bus it uses, on every return
     std::unique_ptr<master::Master>& master;
@@ -418,6 +432,7 @@ ScenarioResult Run::execute() {
     segment.setCableObserver(0, 0, nullptr);
     return r_;
   }
+  master_->resetStatistics();  // the scenario's figures, from the moment all slaves are in OP
   t0_ = clock_.now();
   learnStations();
   checked_.assign(s_.expectations.size(), false);
@@ -428,7 +443,8 @@ ScenarioResult Run::execute() {
   std::uint64_t cycle = 0;
   while (cycle < total) {
     if (clock_.now() > next) {
-      // A blocking recovery took time: the cycles in between had no process data.
+      // A cycle took longer than its period (a frame waited for until it was given up): the
+      // cycles in between had no process data.
       const std::uint64_t skipped =
           static_cast<std::uint64_t>((clock_.now() - next + s_.cycleTime - 1) / s_.cycleTime);
       for (std::uint64_t k = 0; k < skipped && cycle < total; ++k, ++cycle) {
@@ -440,6 +456,9 @@ ScenarioResult Run::execute() {
       if (cycle >= total) break;
     }
     clock_.set(next);
+    // The slaves' firmware runs on its own time, frames or not (an SM watchdog expires while
+    // no frame reaches the slave, not when the next one does).
+    segment.pollSlaves(clock_.now());
     for (std::size_t i = 0; i < s_.actions.size(); ++i) {
       const auto& a = s_.actions[i];
       if (applied[i]) continue;
@@ -472,7 +491,7 @@ ScenarioResult Run::execute() {
     if (clock_.now() < pausedUntil) {
       segment.pollSlaves(clock_.now());
     } else {
-      auto st = master_->exchange();
+      auto st = master_->cycle();
       const auto& last = master_->lastCycle();
       good = st.ok() && last.ok();
       if (last.framesLost > 0) {
@@ -491,10 +510,7 @@ ScenarioResult Run::execute() {
         emergenciesSeen_ = master_->emergencies().size();
         observe(cycle, "emergency", {}, "emergency received");
       }
-      // After an error at once, otherwise every 100 cycles: the AL status of every slave.
-      if (o_.recovery && (!good || cycle % kStatusInterval == 0)) {
-        diagnoseAndRecover(cycle, !st.ok() && last.framesLost == 0);
-      }
+      takeEvents(cycle);
     }
     if (good) {
       run_ = 0;
@@ -502,7 +518,7 @@ ScenarioResult Run::execute() {
       ++badCycles_;
       longestRun_ = std::max(longestRun_, ++run_);
     }
-    cleanCycles_.push_back({cycle, good && allOp()});
+    cleanCycles_.push_back({cycle, good && cleanCycle()});
     ++cycle;
     next += s_.cycleTime;
   }

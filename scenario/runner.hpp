@@ -1,13 +1,15 @@
 // Runs a scenario with our master in-process on virtual time: the network from the topology,
-// the master brought to OP, then one cycle after another with the timeline's actions applied
-// at their cycle or time and the expectations checked at theirs. Everything is virtual time
-// and seeded randomness: the same scenario and seed give the same report and capture, byte for
-// byte.
+// the master brought to OP, then one Master::cycle() after another with the timeline's actions
+// applied at their cycle or time and the expectations checked at theirs. Everything is virtual
+// time and seeded randomness: the same scenario and seed give the same report and capture, byte
+// for byte.
 //
-// Until the master has a recovery of its own, the runner plays the application's part: after
-// a cycle with errors it reads every slave's AL state (what a master reports as lost slaves
-// and state changes) and restarts the bus (scan, configuration, OP) at most every 50 ms.
-// With recovery off it only exchanges process data.
+// The runner is the application and nothing more: it never reads a slave, restarts the bus or
+// helps the master. What the master reports (its cycle results, its events: lost, returned,
+// reset, error, recovered, recovery failed; its health) is what Detected and Statistic
+// expectations judge; the simulator's side (AL state, registers) is what State, Register and
+// BackInOp look at. RunOptions::recovery is MasterOptions::recovery: without it the master
+// only exchanges process data (ecsim scenario run --no-recovery).
 #pragma once
 
 #include <filesystem>
@@ -22,8 +24,7 @@ namespace ecsim::scenario {
 struct RunOptions {
   std::optional<std::uint64_t> seed;  // overrides the file's
   std::filesystem::path pcapDir;      // empty: no capture; else DIR/<name>.pcap
-  bool recovery{true};
-  SimTime recoveryInterval{50 * kNsPerMs};
+  bool recovery{true};                // MasterOptions::recovery
 };
 
 struct ExpectationResult {
