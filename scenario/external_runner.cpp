@@ -144,6 +144,7 @@ class ExternalRun {
   // Shared between the threads.
   std::atomic<bool> stop_{false};
   std::atomic<bool> serving_{false};
+  std::atomic<bool> serverEnded_{false};
   std::atomic<SimTime> zero_{kNoTime};  // time zero (all slaves in OP, or the start)
 
   // Owned by the server thread while it runs.
@@ -200,6 +201,7 @@ void ExternalRun::serve(topology::NetworkServer& server) {
     return stop_.load();
   });
   if (!status.ok()) serverError_ = "the simulator stopped: " + status.error().message();
+  serverEnded_ = true;
 }
 
 // Between two frames (at least every kIdleWait): time zero, the timeline, the timed checks.
@@ -407,6 +409,9 @@ ScenarioResult ExternalRun::execute() {
     return r_;
   }
   network_ = std::move(*network);
+  // From here on SIGINT/SIGTERM end the run in order: the command stopped, the namespace
+  // removed, the report saying so.
+  SignalFlag signals;
   auto ns = VethNamespace::create();
   if (!ns.ok()) {
     r_.error = "cannot make the veth pair for the external master: " + ns.error().message();
@@ -458,7 +463,6 @@ ScenarioResult ExternalRun::execute() {
   serverOptions.paced = true;
   serverOptions.idleWait = kIdleWait;
   topology::NetworkServer server(link, segment, clock_, serverOptions);
-  SignalFlag signals;  // SIGINT/SIGTERM: stop the command, clean up, report
   std::thread thread([this, &server] { serve(server); });
   struct Join {  // the simulator's thread ends before anything it uses, on every return
     std::atomic<bool>& stop;
@@ -495,6 +499,10 @@ ScenarioResult ExternalRun::execute() {
   for (;;) {
     if (signals.raised()) {
       interrupted = true;
+      break;
+    }
+    if (serverEnded_) {
+      endText = "the simulator stopped";
       break;
     }
     if (auto code = child->wait(std::chrono::nanoseconds(0)); code.ok()) {

@@ -1,6 +1,7 @@
 // A scenario (docs/scenarios.md): a network, the master that runs it, a timeline of fault
 // actions and the expectations a run is judged by. Read from XML; every error names the file
-// and line.
+// and line. The master is ours in-process (scenario/runner.hpp) or an external command under
+// test (<Master kind="external" command="prog {iface}"/>, scenario/external_runner.hpp).
 //
 //   <Scenario name="cable_break" topology="../examples/topologies/demo.xml" cycleUs="1000"
 //             durationMs="3000" seed="1">
