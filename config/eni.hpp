@@ -153,8 +153,11 @@ struct EniCyclicCmd {
   std::optional<std::uint32_t> addr;  // logical address (LRD/LWR/LRW)
   std::uint16_t dataLength{0};
   std::optional<std::uint16_t> cnt;
-  std::optional<std::uint32_t> inputOffs;   // byte offset in the frame
-  std::optional<std::uint32_t> outputOffs;  // byte offset in the frame
+  // Where the Cmd's data goes in the input / output process image, in bytes (ETG.2100; a
+  // TwinCAT image mirrors the frames, so the first Cmd's is 26 = 14 + 2 + 10), which for
+  // ecsim's own ENIs is the data's offset in the frame (master/eni_config.hpp reads both).
+  std::optional<std::uint32_t> inputOffs;
+  std::optional<std::uint32_t> outputOffs;
   int line{0};
 };
 

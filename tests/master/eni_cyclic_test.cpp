@@ -248,6 +248,48 @@ TEST_F(EniCyclicTest, AnotherLogicalStartAddressIsWhereTheFmmusAndTheLrwGo) {
   for (std::size_t i = 0; i < kCount; ++i) EXPECT_EQ(sim(i).state(), AlState::kInit) << i;
 }
 
+// The same network as a TwinCAT-style ENI would describe it (ETG.2100 images): the LRW at
+// logical 0x01000000, process images of 1536 bytes that hold each Cmd's data at its
+// OutputOffs/InputOffs (26: where the data lies in the frame), and every <Send>/<Recv> BitStart
+// and variable BitOffs in those images, not at logical addresses.
+TEST_F(EniCyclicTest, Etg2100ImagesMapThroughTheCmdOffsets) {
+  EniConfig eni = exportedEni();
+  constexpr std::uint32_t kLogical = 0x01000000;
+  constexpr std::uint32_t kImageBits = 26 * 8;  // the data's place in the frame and the image
+  ASSERT_EQ(cmdsOf(eni, 0).size(), 1u);
+  EniCyclicCmd& lrw = cmdsOf(eni, 0)[0];
+  ASSERT_EQ(*lrw.addr, 0u);
+  ASSERT_EQ(lrw.inputOffs, 26u);
+  ASSERT_EQ(lrw.outputOffs, 26u);
+  *lrw.addr = kLogical;
+  eni.processImage.outputByteSize = 1536;
+  eni.processImage.inputByteSize = 1536;
+  for (auto& s : eni.slaves) {
+    for (auto& r : s.processData.send) r.bitStart += kImageBits;
+    for (auto& r : s.processData.recv) r.bitStart += kImageBits;
+  }
+  for (auto& v : eni.processImage.outputs) v.bitOffs += kImageBits;
+  for (auto& v : eni.processImage.inputs) v.bitOffs += kImageBits;
+  auto status = startWith(eni);
+  ASSERT_TRUE(status.ok()) << status.error().message();
+  for (std::size_t i = 0; i < kCount; ++i) EXPECT_EQ(sim(i).state(), AlState::kOp) << i;
+  EXPECT_EQ(master_->layout().logicalBase, kLogical);
+  EXPECT_EQ(master_->layout().outputBytes, 27u);
+  EXPECT_EQ(master_->layout().inputBytes, 39u);
+  // DO1's outputs were at image byte 26 + 0: logical 0x01000000; DI1's inputs at 26 + 27.
+  auto fmmu = master_->readRegisters(kDo, 0x0600, 16);
+  ASSERT_TRUE(fmmu.ok()) << fmmu.error().message();
+  EXPECT_EQ(readLe32(*fmmu, 0), kLogical);
+  fmmu = master_->readRegisters(kDi, 0x0600, 16);
+  ASSERT_TRUE(fmmu.ok()) << fmmu.error().message();
+  EXPECT_EQ(readLe32(*fmmu, 0), kLogical + 27);
+  const auto frames = runCaptured(1000);
+  ASSERT_EQ(frames.size(), 1000u);
+  const std::vector<WireDatagram> want{{Command::kLrw, kLogical, 66}};
+  for (const auto& f : frames) ASSERT_EQ(f, want) << describe(f);
+  checkVariablesByEniName();
+}
+
 // The exported single LRW becomes an LWR of the outputs in frame 0 and an LRD of the inputs in
 // frame 1, followed there by a BRD of AL status that only OP sends.
 EniConfig splitWithAlStatusBrd(EniConfig eni) {
