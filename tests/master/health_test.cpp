@@ -1,7 +1,10 @@
 // Cyclic health and recovery against the in-process simulator on virtual time: a line of
 // ecsim's demo devices (examples/topologies/demo.xml without the second drive) runs at 1 ms;
 // a cable is pulled and put back, a slave is power-cycled, a slave drops to SAFEOP+ERROR, and
-// with recovery off the same faults stay errors. Also the latency histogram.
+// with recovery off the same faults stay errors. A power-cycled drive gets its PDO assignment
+// back over CoE; a recovery that cannot succeed (EEPROM checksum error, silent mailbox, SDO
+// abort) is reported once with its reason and retried. The SlaveSetup the master gives its
+// recoveries (PDO assignment, ENI init commands). Also the latency histogram.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,6 +13,8 @@
 #include "master/health.hpp"
 #include "master/histogram.hpp"
 #include "master/master.hpp"
+#include "master/recovery.hpp"
+#include "protocol/sdo.hpp"
 #include "tests/master/bring_up.hpp"
 
 namespace ecsim::testing {
@@ -84,6 +89,41 @@ TEST(LatencyHistogramTest, MeanMergeNegativeAndEmpty) {
 // ---- recovery on the demo line -------------------------------------------------------------
 
 enum : std::size_t { kCoupler, kDi, kDo, kAi, kDrive, kCount };
+
+// Stands between a simulated slave and its mailbox server: records the SDO downloads it gets,
+// and can swallow every request (silent) or abort those for one object.
+class WatchedMailbox final : public slavesim::MailboxServer {
+ public:
+  explicit WatchedMailbox(std::unique_ptr<slavesim::MailboxServer> inner)
+      : inner_(std::move(inner)) {}
+  void onRequest(slavesim::Esc& esc, ConstBytes mailbox, SimTime now) override {
+    auto request = decodeSdoRequestMailbox(mailbox);
+    const auto* down =
+        request.ok() ? std::get_if<SdoInitiateDownloadRequest>(&request->sdo) : nullptr;
+    if (down != nullptr) downloads.emplace_back(down->index, down->subindex);
+    if (silent) return;
+    if (down != nullptr && abortIndex == down->index) {
+      std::array<std::uint8_t, 64> out{};
+      MailboxHeader header;
+      header.counter = request->mailbox.counter;
+      auto n = encodeSdoResponseMailbox(
+          out, SdoResponse{SdoAbort{down->index, down->subindex, 0x06010000}}, header);
+      if (n.ok()) (void)esc.pdiMailboxSend(ConstBytes(out.data(), *n));
+      return;
+    }
+    inner_->onRequest(esc, mailbox, now);
+  }
+  void poll(slavesim::Esc& esc, SimTime now) override {
+    if (!silent) inner_->poll(esc, now);
+  }
+
+  std::vector<std::pair<std::uint16_t, std::uint8_t>> downloads;
+  bool silent{false};
+  std::optional<std::uint16_t> abortIndex;
+
+ private:
+  std::unique_ptr<slavesim::MailboxServer> inner_;
+};
 
 class RecoveryTest : public ::testing::Test {
  protected:
@@ -247,6 +287,210 @@ TEST_F(RecoveryTest, WithoutRecoveryAPulledCableStaysAWorkingCounterError) {
   EXPECT_TRUE(master_->events().empty()) << eventLog();
   EXPECT_GE(master_->statistics().wkcErrors, 100u);
   EXPECT_EQ(master_->health().slavesLost, 0u);
+}
+
+// ---- what a recovery gives back, and recoveries that cannot succeed -------------------------
+
+class RecoveryFailureTest : public RecoveryTest {
+ protected:
+  WatchedMailbox& watchDriveMailbox() {
+    auto watched = std::make_unique<WatchedMailbox>(sim(kDrive).takeMailboxServer());
+    WatchedMailbox& ref = *watched;
+    sim(kDrive).setMailboxServer(std::move(watched));
+    return ref;
+  }
+  void powerCycle(std::size_t i) {
+    sim(i).powerOff();
+    sim(i).powerOn();
+  }
+  std::size_t countEvents(MasterEventKind kind, std::size_t position) const {
+    return static_cast<std::size_t>(
+        std::count_if(master_->events().begin(), master_->events().end(),
+                      [&](const auto& e) { return e.kind == kind && e.position == position; }));
+  }
+};
+
+TEST_F(RecoveryFailureTest, PowerCycledDriveGetsItsPdoAssignmentBackOverCoe) {
+  build();
+  EXPECT_EQ(run(100), 0u);
+  WatchedMailbox& mailbox = watchDriveMailbox();
+  powerCycle(kDrive);
+  runUntil([&] { return findEvent(MasterEventKind::kSlaveRecovered, kDrive) != nullptr; }, 3000);
+  ASSERT_NE(findEvent(MasterEventKind::kSlaveRecovered, kDrive), nullptr) << eventLog();
+  // What the master found at start-up (the drive's CoE dictionary), written back the way a
+  // PDO assignment is changed: sub 0 cleared, the PDOs, then their number.
+  const auto& data = master_->processData()[kDrive];
+  ASSERT_EQ(data.source, master::PdoSource::kCoe);
+  std::vector<std::pair<std::uint16_t, std::uint8_t>> expected;
+  for (const auto& sm : data.sms) {
+    const auto index = static_cast<std::uint16_t>(0x1C10 + sm.sm);
+    expected.emplace_back(index, 0);
+    for (std::size_t k = 0; k < sm.pdos.size(); ++k) {
+      expected.emplace_back(index, static_cast<std::uint8_t>(k + 1));
+    }
+    expected.emplace_back(index, 0);
+  }
+  EXPECT_GE(expected.size(), 6u);  // 0x1C12 and 0x1C13, one PDO each at least
+  EXPECT_EQ(mailbox.downloads, expected);
+  EXPECT_EQ(sim(kDrive).state(), AlState::kOp);
+  EXPECT_EQ(run(200), 0u);
+}
+
+TEST_F(RecoveryFailureTest, SilentMailboxFailsTheRecoveryOnceRetriesAndRecoversWhenItAnswers) {
+  build();
+  EXPECT_EQ(run(100), 0u);
+  WatchedMailbox& mailbox = watchDriveMailbox();
+  mailbox.silent = true;
+  powerCycle(kDrive);
+  run(3500);  // the first attempt times out, two retries (every 1000 cycles) too
+  ASSERT_EQ(countEvents(MasterEventKind::kRecoveryFailed, kDrive), 1u) << eventLog();
+  const auto* failed = findEvent(MasterEventKind::kRecoveryFailed, kDrive);
+  EXPECT_NE(failed->text.find("PDO assignment 0x1C12:00"), std::string::npos) << failed->text;
+  EXPECT_NE(failed->text.find("tried again every 1000 cycles"), std::string::npos) << failed->text;
+  EXPECT_EQ(countEvents(MasterEventKind::kSlaveReturned, kDrive), 0u) << eventLog();
+  const auto h = master_->health();
+  EXPECT_NE(h.slaves[kDrive].condition, SlaveCondition::kOperational);  // failed, or retrying
+  EXPECT_GE(h.slaves[kDrive].failedAttempts, 2u);
+  EXPECT_EQ(sim(kDrive).state(), AlState::kPreOp);  // its mailbox works in PREOP: no further
+  EXPECT_EQ(run(100), 0u);                          // the others run clean meanwhile
+  mailbox.silent = false;
+  const auto back = runUntil(
+      [&] { return findEvent(MasterEventKind::kSlaveRecovered, kDrive) != nullptr; }, 3000);
+  EXPECT_LE(back, 2200u) << eventLog();  // the attempt under way times out, the next succeeds
+  EXPECT_EQ(sim(kDrive).state(), AlState::kOp);
+  EXPECT_TRUE(master_->health().allOperational());
+}
+
+TEST_F(RecoveryFailureTest, SdoAbortOnThePdoAssignmentIsReportedWithTheAbortCode) {
+  build();
+  EXPECT_EQ(run(100), 0u);
+  WatchedMailbox& mailbox = watchDriveMailbox();
+  mailbox.abortIndex = 0x1C12;
+  powerCycle(kDrive);
+  run(500);
+  const auto* failed = findEvent(MasterEventKind::kRecoveryFailed, kDrive);
+  ASSERT_NE(failed, nullptr) << eventLog();
+  EXPECT_NE(failed->text.find("0x06010000"), std::string::npos) << failed->text;
+  EXPECT_NE(sim(kDrive).state(), AlState::kOp);
+}
+
+TEST_F(RecoveryFailureTest, EepromChecksumErrorIsReportedOnceAndTheOthersKeepRunning) {
+  build();
+  EXPECT_EQ(run(100), 0u);
+  constexpr std::size_t kChecksumByte = 14;  // SII word 7, low byte (ETG.1000.6 table 9)
+  auto& esc = sim(kAi).esc();
+  esc.writeSiiByte(kChecksumByte, static_cast<std::uint8_t>(esc.sii()[kChecksumByte] ^ 0x5A));
+  powerCycle(kAi);
+  ASSERT_FALSE(sim(kAi).firmwareRunning());
+  run(2500);
+  ASSERT_NE(findEvent(MasterEventKind::kSlaveReset, kAi), nullptr) << eventLog();
+  ASSERT_EQ(countEvents(MasterEventKind::kRecoveryFailed, kAi), 1u) << eventLog();
+  const auto* failed = findEvent(MasterEventKind::kRecoveryFailed, kAi);
+  EXPECT_NE(failed->text.find("EEPROM checksum error"), std::string::npos) << failed->text;
+  EXPECT_NE(failed->text.find("cannot leave INIT"), std::string::npos) << failed->text;
+  EXPECT_GE(master_->health().slaves[kAi].failedAttempts, 3u);
+  EXPECT_EQ(findEvent(MasterEventKind::kSlaveRecovered, kAi), nullptr);
+  // Its station address is back (the slave answers), the rest of the line cycles clean.
+  EXPECT_EQ(esc.reg16(reg::kConfiguredStationAddress.address), 0x1004);
+  EXPECT_EQ(run(200), 0u);
+  EXPECT_EQ(sim(kDrive).state(), AlState::kOp);
+}
+
+// ---- SlaveSetup ----------------------------------------------------------------------------
+
+TEST(SlaveSetupTest, PdoAssignmentWritesOnlyForPdosFoundThroughCoe) {
+  master::SlaveProcessData data;
+  data.source = master::PdoSource::kCoe;
+  data.sms.push_back({2, true, {{0x1600, "", {}}, {0x1601, "", {}}}});
+  data.sms.push_back({3, false, {}});
+  const auto writes = master::pdoAssignmentWrites(data);
+  ASSERT_EQ(writes.size(), 6u);
+  EXPECT_EQ(writes[0].index, 0x1C12);
+  EXPECT_EQ(writes[0].data, std::vector<std::uint8_t>{0});
+  EXPECT_EQ(writes[1].subindex, 1);
+  EXPECT_EQ(writes[1].data, (std::vector<std::uint8_t>{0x00, 0x16}));  // 0x1600, little-endian
+  EXPECT_EQ(writes[2].data, (std::vector<std::uint8_t>{0x01, 0x16}));
+  EXPECT_EQ(writes[3].subindex, 0);
+  EXPECT_EQ(writes[3].data, std::vector<std::uint8_t>{2});
+  EXPECT_EQ(writes[4].index, 0x1C13);  // an empty assignment is written as empty
+  EXPECT_EQ(writes[5].data, std::vector<std::uint8_t>{0});
+  EXPECT_NE(writes[1].what.find("0x1C12:01"), std::string::npos) << writes[1].what;
+  data.source = master::PdoSource::kSii;  // the SII's PDOs are fixed: nothing to write
+  EXPECT_TRUE(master::pdoAssignmentWrites(data).empty());
+}
+
+TEST(SlaveSetupTest, AnEniSlaveGetsItsInitCommandsPerTransition) {
+  EniConfig eni;
+  eni.file = "bus.xml";
+  EniSlave slave;
+  auto reg = [](std::uint16_t ado, std::vector<std::uint8_t> data, std::vector<char> from,
+                std::vector<char> to, int line, std::uint8_t cmd = 5) {
+    EniRegisterCmd c;
+    for (std::size_t k = 0; k < from.size(); ++k) c.transitions.push_back({from[k], to[k]});
+    c.cmd = cmd;
+    c.ado = ado;
+    c.data = std::move(data);
+    c.line = line;
+    return c;
+  };
+  slave.initCmds.push_back(reg(0x0800, {1, 2, 3, 4}, {'I'}, {'P'}, 10));   // SM0
+  slave.initCmds.push_back(reg(0x0120, {2, 0}, {'I'}, {'P'}, 11));         // AL control
+  slave.initCmds.push_back(reg(0x0010, {0x05, 0x10}, {'I'}, {'P'}, 12));   // station address
+  slave.initCmds.push_back(reg(0x0130, {}, {'I'}, {'P'}, 13, 4));          // a read
+  slave.initCmds.push_back(reg(0x0810, {5, 6, 7, 8}, {'P'}, {'S'}, 14));   // SM2
+  slave.initCmds.push_back(reg(0x0600, {9}, {'P', 'S'}, {'S', 'O'}, 15));  // FMMU0
+  EniMailbox mailbox;
+  EniCoeCmd pdo;
+  pdo.transitions.push_back({'P', 'S'});
+  pdo.index = 0x1C12;
+  pdo.subIndex = 0;
+  pdo.data = {0};
+  pdo.line = 20;
+  EniCoeCmd ip = pdo;
+  ip.transitions = {{'I', 'P'}};
+  ip.index = 0x6060;
+  ip.line = 21;
+  EniCoeCmd upload = pdo;
+  upload.ccs = 2;
+  upload.line = 22;
+  mailbox.coeInitCmds = {pdo, ip, upload};
+  slave.mailbox = mailbox;
+  eni.slaves.push_back(slave);
+  std::optional<MasterConfig> config = masterConfigFromEni(eni);
+  std::vector<master::SlaveProcessData> processData(1);
+  master::MasterSlaveSetup setup(processData, config);
+  master::SlaveInfo info;
+  info.position = 0;
+
+  auto lines = [](const std::vector<master::SetupWrite>& writes) {
+    std::vector<std::string> out;
+    for (const auto& w : writes) out.push_back(w.what);
+    return out;
+  };
+  const auto preop = setup.writesFor(info, AlState::kPreOp);
+  ASSERT_EQ(preop.size(), 1u) << ::testing::PrintToString(lines(preop));
+  EXPECT_EQ(preop[0].kind, master::SetupWrite::Kind::kRegister);
+  EXPECT_EQ(preop[0].index, 0x0800);
+  EXPECT_NE(preop[0].what.find("bus.xml line 10"), std::string::npos) << preop[0].what;
+  // In PREOP: the CoE commands of IP (a mailbox exists from PREOP on), then those of PS.
+  const auto safeop = setup.writesFor(info, AlState::kSafeOp);
+  ASSERT_EQ(safeop.size(), 4u) << ::testing::PrintToString(lines(safeop));
+  EXPECT_EQ(safeop[0].index, 0x6060);
+  EXPECT_EQ(safeop[0].kind, master::SetupWrite::Kind::kSdo);
+  EXPECT_EQ(safeop[1].index, 0x0810);
+  EXPECT_EQ(safeop[2].index, 0x0600);
+  EXPECT_EQ(safeop[3].index, 0x1C12);
+  EXPECT_NE(safeop[3].what.find("line 20"), std::string::npos) << safeop[3].what;
+  const auto op = setup.writesFor(info, AlState::kOp);
+  ASSERT_EQ(op.size(), 1u);
+  EXPECT_EQ(op[0].index, 0x0600);
+  // Without an ENI: the PDO assignment found through CoE, for SAFEOP only.
+  std::optional<MasterConfig> none;
+  processData[0].source = master::PdoSource::kCoe;
+  processData[0].sms.push_back({2, true, {{0x1600, "", {}}}});
+  master::MasterSlaveSetup own(processData, none);
+  EXPECT_TRUE(own.writesFor(info, AlState::kPreOp).empty());
+  EXPECT_EQ(own.writesFor(info, AlState::kSafeOp).size(), 3u);
 }
 
 }  // namespace

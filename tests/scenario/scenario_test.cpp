@@ -2,6 +2,7 @@
 // determinism a CI system relies on: the same scenario and seed give the same report and pcap.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -110,6 +111,64 @@ TEST(Runner, SameSeedSameReportAndCapture) {
   c.seed = 99;
   EXPECT_NE(formatReport(runScenario(*s, c)), ra);  // another seed, other losses
   std::filesystem::remove_all(dir);
+}
+
+// The acceptance of issue #9: every shipped scenario passes with our master, and fails when the
+// master does not react (MasterOptions::recovery off) - only on expectations marked
+// needsRecovery, so each failure is for the right reason.
+TEST(Runner, ShippedScenariosPassWithRecoveryAndFailWithoutOnlyWhereMarked) {
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::directory_iterator(kDir)) {
+    if (entry.path().extension() == ".xml") files.push_back(entry.path());
+  }
+  std::sort(files.begin(), files.end());
+  ASSERT_GE(files.size(), 15u);
+  for (const auto& file : files) {
+    auto s = loadScenario(file);
+    ASSERT_TRUE(s.ok()) << s.error().message();
+    if (s->masterKind != "in-process") continue;
+    const auto with = runScenario(*s);
+    EXPECT_TRUE(with.passed()) << formatReport(with);
+    RunOptions off;
+    off.recovery = false;
+    const auto without = runScenario(*s, off);
+    ASSERT_TRUE(without.error.empty()) << without.error;
+    EXPECT_GE(without.failures(), 1u) << file << " passes without recovery";
+    for (const auto& x : without.results) {
+      EXPECT_TRUE(x.passed || x.needsRecovery)
+          << file.filename() << " line " << x.line << " fails without recovery but is not marked "
+          << "needsRecovery: " << x.what << ": " << x.observed;
+    }
+  }
+}
+
+// The report shows what the master reported (its events), and Statistic counts them by name.
+TEST(Runner, ReportsTheMastersEventsAndCountsThem) {
+  auto s = loadScenario(kDir / "power_cycle_drive.xml");
+  ASSERT_TRUE(s.ok()) << s.error().message();
+  Expectation x;
+  x.line = 998;
+  x.kind = ExpectKind::kStatistic;
+  x.name = "slave-lost";
+  x.slave = "Drive2";
+  x.value = 1;
+  s->expectations.push_back(x);
+  x.line = 999;
+  x.name = "slave-lost";
+  x.slave = "Drive1";  // not lost: it only lost its link at port 1
+  x.value = 0;
+  s->expectations.push_back(x);
+  const auto r = runScenario(*s);
+  const std::string report = formatReport(r);
+  EXPECT_TRUE(r.passed()) << report;
+  EXPECT_NE(report.find("master: slave 5 (0x1006 'ECS7201 CiA 402 servo drive') lost"),
+            std::string::npos)
+      << report;
+  EXPECT_NE(report.find("answers at its position with station address 0 (power cycle)"),
+            std::string::npos)
+      << report;
+  EXPECT_NE(report.find("back in OP"), std::string::npos) << report;
+  EXPECT_EQ(report.find("restart"), std::string::npos) << report;  // the runner restarts nothing
 }
 
 }  // namespace
