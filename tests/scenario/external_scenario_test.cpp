@@ -12,6 +12,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 
 #include "link/netns.hpp"
@@ -135,6 +136,29 @@ TEST_F(ExternalScenario, ACommandStillRunningAtTheEndIsStopped) {
   EXPECT_NE(formatReport(r).find("command stopped (stopped with SIGTERM)"), std::string::npos)
       << formatReport(r);
   expectNoNamespaceLeft();
+}
+
+TEST_F(ExternalScenario, ReportsDifferOnlyInMeasuredTimes) {
+  ECSIM_REQUIRE_NETWORK();
+  auto s = write("<Master kind=\"external\" timeZero=\"start\" command=\"echo one; echo two\"/>",
+                 "<ExitStatus value=\"0\"/>\n<Output contains=\"two\"/>\n"
+                 "<State slave=\"DI1\" state=\"OP\"/>\n");
+  const std::regex times("-?[0-9]+\\.[0-9]{3} ms");
+  std::string first;
+  for (int run = 0; run < 2; ++run) {
+    auto r = runExternalScenario(s);
+    ASSERT_TRUE(r.error.empty()) << r.error;
+    const std::string report = std::regex_replace(formatReport(r), times, "T ms");
+    if (run == 0) {
+      first = report;
+      EXPECT_NE(
+          report.find("FAIL  t.xml, line 7: State DI1 is OP at the end\n        at T ms: INIT"),
+          std::string::npos)
+          << report;
+    } else {
+      EXPECT_EQ(report, first);
+    }
+  }
 }
 
 TEST_F(ExternalScenario, SigintStopsTheCommandAndRemovesTheNamespace) {
