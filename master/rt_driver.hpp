@@ -1,28 +1,45 @@
 // The real-time driver: the step-driven master on three threads, as a user-space real-time
 // master runs on Linux (or Xenomai). Highest priority first:
 //
-//   send/receive  woken by the cyclic task each period; runs Master::cycle(): the cached
-//                 frames out, the answers in (sleeping on the link's descriptor), WKC check,
-//                 health, one recovery step
-//   control       every controlPeriod: copies statistics, health and new events into a
-//                 snapshot for the non-real-time world (a UI, a logger), so that nothing
-//                 outside these threads ever touches the master while it runs
+//   send/receive  woken by the cyclic task each period; only I/O: Master::sendCycle() (the
+//                 cached frames and whatever datagrams are queued go out), pollCycle() until
+//                 the answers are in (sleeping on the link's descriptor, through the Bus, in
+//                 between), finishCycle() (inputs, WKC check). Nothing else: no health, no
+//                 recovery, no allocation
+//   control       after every finished cycle (or at most once per controlPeriod):
+//                 Master::control(), i.e. the state machines: AL status reads, lost and
+//                 returning slaves, one recovery step; the datagrams it queues go out with the
+//                 next cyclic send, as IgH's master thread queues datagrams that the
+//                 application's send carries. Every snapshotPeriod it copies statistics,
+//                 health and new events into a snapshot for the non-real-time world (a UI, a
+//                 logger), so that nothing outside these threads touches the master while it
+//                 runs
 //   cyclic task   sleeps with clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME) to the next
 //                 period, measures how late it woke, runs the application (outputs from
-//                 inputs, under the master lock), then hands the cycle to send/receive and
-//                 waits for it
+//                 inputs), then hands the cycle to send/receive and waits for it
+//
+// One lock, the master lock, guards the Master: its Transport (not thread-safe), cyclic
+// frames, health monitor and process image. Every step above runs under it and none blocks;
+// send/receive waits for frames outside it. It is a priority-inheritance mutex, so the
+// control thread or the cyclic task holding it runs at send/receive's priority while that
+// waits for it.
 //
 // Threads are created SCHED_FIFO at the given priorities and memory is locked (mlockall)
 // where the process may (root, CAP_SYS_NICE / CAP_IPC_LOCK, or rtprio/memlock limits);
-// otherwise they run as ordinary threads and warnings() says so, once, clearly. The master
-// core stays what it is: the same Master runs on virtual time in tests without this driver.
+// otherwise they run as ordinary threads and warnings() says so, once, clearly. With
+// RtDriverOptions::cpu all three are pinned to that CPU. The bus given to the Master is used
+// by send/receive only (the control thread steps with the time the last cycle finished), so a
+// VirtualBus works too; the same Master runs on virtual time in tests without this driver.
 #pragma once
+
+#include <pthread.h>
 
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -39,19 +56,48 @@ struct RtDriverOptions {
   int controlPriority{70};
   int cyclicPriority{60};
   bool lockMemory{true};
-  SimTime controlPeriod{100 * kNsPerMs};
+  // Master::control() after every finished cycle (0) or at most once per this period.
+  SimTime controlPeriod{0};
+  // How often the control thread copies the snapshot.
+  SimTime snapshotPeriod{100 * kNsPerMs};
+  // Pins all three threads to this CPU (sched affinity); nullopt: the kernel decides.
+  std::optional<int> cpu;
 };
 
 // What the control thread last copied out of the master.
 struct RtSnapshot {
   std::uint64_t cycles{0};  // run by the driver
   std::uint64_t failedCycles{0};
-  std::uint64_t overruns{0};  // the cycle did not finish within its period
+  std::uint64_t overruns{0};      // the cycle did not finish within its period
+  std::uint64_t controlSteps{0};  // Master::control() calls by the control thread
   std::string firstError;
   CyclicStatistics statistics;
   MasterHealth health;
   std::vector<MasterEvent> events;  // all events so far
   LatencyHistogram wakeLatency;     // how late the cyclic task woke, per cycle
+};
+
+// One of the driver's threads as the kernel sees it (RtDriver::threads()).
+struct RtThreadInfo {
+  std::string name;  // "ec-sendrecv", "ec-control", "ec-cyclic"
+  int policy{0};     // SCHED_FIFO, SCHED_OTHER, ...
+  int priority{0};
+  std::vector<int> cpus;  // the CPUs it may run on
+};
+
+// A mutex with priority inheritance (PTHREAD_PRIO_INHERIT); BasicLockable, for
+// std::lock_guard / std::unique_lock.
+class PiMutex {
+ public:
+  PiMutex();
+  ~PiMutex();
+  PiMutex(const PiMutex&) = delete;
+  PiMutex& operator=(const PiMutex&) = delete;
+  void lock();
+  void unlock();
+
+ private:
+  pthread_mutex_t mutex_;
 };
 
 class RtDriver {
@@ -66,7 +112,7 @@ class RtDriver {
 
   // Starts the three threads (the master must be in OP: start() first). kState when running.
   Status start(Application application = {});
-  // Stops after the cycle in progress and joins the threads.
+  // Stops after the cycle in progress (whose control step still runs) and joins the threads.
   void stop();
   bool running() const { return running_.load(); }
 
@@ -75,6 +121,8 @@ class RtDriver {
   bool memoryLocked() const { return memoryLocked_; }
   // "real-time scheduling not available (Operation not permitted): ..." and the like.
   const std::vector<std::string>& warnings() const { return warnings_; }
+  // Send/receive, control, cyclic task, read back from the kernel (empty when not running).
+  std::vector<RtThreadInfo> threads() const;
 
   RtSnapshot snapshot() const;
 
@@ -82,8 +130,11 @@ class RtDriver {
   void sendReceiveLoop();
   void controlLoop();
   void cyclicLoop();
+  // One cycle's I/O: send, poll until answered (waiting on the bus unlocked), finish.
+  Status exchangeOnce();
   void takeSnapshot();
-  // Starts `loop` on `thread` and asks for SCHED_FIFO `priority`: 0 or the error number.
+  // Starts `loop` on `thread`, names it, asks for SCHED_FIFO `priority`: 0 or the error
+  // number; a failed pinning is a warning.
   int spawn(std::thread& thread, int priority, void (RtDriver::*loop)(), const char* name);
 
   Master& master_;
@@ -95,19 +146,24 @@ class RtDriver {
   bool memoryLocked_{false};
   std::vector<std::string> warnings_;
 
-  std::mutex masterLock_;  // the master and its process image
-  std::mutex handoffLock_;
+  PiMutex masterLock_;     // the master: transport, cyclic frames, health, process image
+  SimTime lastFinish_{0};  // when send/receive finished the last cycle (bus clock)
+  std::uint64_t controlSteps_{0};
+  LatencyHistogram wakeLatency_;
+  std::size_t eventsCopied_{0};  // of master_.events(), into snapshot_
+
+  std::mutex handoffLock_;  // the hand-offs between the threads
   std::condition_variable handoff_;
-  std::uint64_t requested_{0};  // cycles handed to send/receive
-  std::uint64_t completed_{0};  // cycles it finished
-  bool cyclicDone_{false};      // the cyclic task has ended (no more requests)
+  std::uint64_t requested_{0};   // cycles handed to send/receive
+  std::uint64_t completed_{0};   // cycles it finished
+  bool cyclicDone_{false};       // the cyclic task has ended (no more requests)
+  bool sendReceiveDone_{false};  // send/receive has ended (no more cycles to control)
 
   mutable std::mutex snapshotLock_;
   RtSnapshot snapshot_;
   std::atomic<std::uint64_t> failedCycles_{0};
   std::atomic<std::uint64_t> overruns_{0};
-  std::string firstError_;        // under snapshotLock_
-  LatencyHistogram wakeLatency_;  // under masterLock_
+  std::string firstError_;  // under snapshotLock_
 
   std::thread sendReceive_;
   std::thread control_;

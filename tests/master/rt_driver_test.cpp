@@ -1,6 +1,7 @@
 // The real-time driver's threads around a master on the in-process simulator: the cyclic task
-// wakes on real time (clock_nanosleep), the send/receive thread runs Master::cycle() on the
-// virtual-time bus, the control thread publishes snapshots. Whether SCHED_FIFO was granted
+// wakes on real time (clock_nanosleep), the send/receive thread runs the cycle's I/O steps on
+// the virtual-time bus (whose waits serve the simulator), the control thread steps health and
+// publishes snapshots. Whether SCHED_FIFO was granted
 // depends on the environment: either realtime() or a warning that says why not.
 #include "master/rt_driver.hpp"
 
@@ -26,7 +27,7 @@ TEST(RtDriverTest, RunsCyclesWithTheApplicationAndPublishesSnapshots) {
 
   master::RtDriverOptions options;
   options.period = 2 * kNsPerMs;
-  options.controlPeriod = 10 * kNsPerMs;
+  options.snapshotPeriod = 10 * kNsPerMs;
   options.lockMemory = false;  // keep the test process's memory as it is
   master::RtDriver driver(m, options);
   std::uint64_t calls = 0;

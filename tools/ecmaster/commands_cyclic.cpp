@@ -2,11 +2,15 @@
 // recovery (Master::cycle), print a live line every second (stderr with --json), then a
 // summary: round trip and cycle jitter (min, mean, max, p99, p99.9), lost, late and WKC
 // errors, slave events. --show NAME prints process variables; --rt runs the master on the
-// real-time driver's threads (master/rt_driver.hpp).
+// real-time driver's threads (master/rt_driver.hpp); --cpu N pins them (or, without --rt, the
+// thread that runs the cycles) to one CPU.
 #include <fmt/core.h>
+#include <sched.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <thread>
 
 #include "link/signal_flag.hpp"
@@ -22,8 +26,18 @@ struct CyclicOptions {
   bool stopAtEnd{true};
   bool rt{false};
   bool quiet{false};
+  int cpu{-1};  // --cpu: pin to this CPU
   std::vector<std::string> show;
 };
+
+// Pins the calling thread (the one running Master::cycle() without --rt).
+std::optional<std::string> pinThisThread(int cpu) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  CPU_SET(static_cast<std::size_t>(cpu), &set);
+  if (sched_setaffinity(0, sizeof(set), &set) == 0) return std::nullopt;
+  return fmt::format("not pinned to CPU {} ({})", cpu, std::strerror(errno));
+}
 
 double us(SimTime ns) {
   return static_cast<double>(ns) / 1e3;
@@ -100,6 +114,7 @@ int runCyclic(const GlobalOptions& g, const CyclicOptions& o) {
   if (o.rt) {
     master::RtDriverOptions rto;
     rto.period = cycle;
+    if (o.cpu >= 0) rto.cpu = o.cpu;
     master::RtDriver driver(m, rto);
     if (auto s = driver.start(); !s.ok()) return fail(s.error());
     warnings = driver.warnings();
@@ -129,6 +144,12 @@ int runCyclic(const GlobalOptions& g, const CyclicOptions& o) {
     r.events = snap.events;
     r.wakeLatency = snap.wakeLatency;
   } else {
+    if (o.cpu >= 0) {
+      if (auto w = pinThisThread(o.cpu)) {
+        warnings.push_back(*w);
+        fmt::print(stderr, "ecmaster: warning: {}\n", *w);
+      }
+    }
     const SimTime start = bus.now();
     SimTime next = start;
     SimTime nextPrint = start + kNsPerSecond;
@@ -185,6 +206,7 @@ int runCyclic(const GlobalOptions& g, const CyclicOptions& o) {
       j["warnings"] = warnings;
       if (r.wakeLatency) j["wakeLatencyUs"] = histogramJson(*r.wakeLatency);
     }
+    if (o.cpu >= 0) j["cpu"] = o.cpu;
     nlohmann::json events = nlohmann::json::array();
     for (const auto& e : r.events) {
       events.push_back({{"cycle", e.cycle},
@@ -234,6 +256,10 @@ CommandRunner addCyclicCommand(CLI::App& app, const GlobalOptions& global) {
                   "repeatable");
   cmd->add_flag("--rt", o->rt,
                 "Run on real-time threads (SCHED_FIFO, mlockall; a warning when not permitted)");
+  cmd->add_option("--cpu", o->cpu,
+                  "Pin the cycle to this CPU: with --rt the send/receive, control and cyclic "
+                  "threads, else the thread that runs the cycles")
+      ->check(CLI::Range(0, CPU_SETSIZE - 1));
   cmd->add_flag("--quiet", o->quiet, "No live line every second");
   return [&global, o] { return runCyclic(global, *o); };
 }
