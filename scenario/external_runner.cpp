@@ -1,20 +1,20 @@
 #include "scenario/external_runner.hpp"
 
+#include <fcntl.h>
 #include <fmt/core.h>
 #include <pthread.h>
 #include <sched.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cerrno>
 #include <climits>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <optional>
 #include <regex>
-#include <sstream>
 #include <thread>
 #include <vector>
 
@@ -63,22 +63,53 @@ std::string excerpt(std::string_view line) {
   return "'" + std::string(line.substr(0, kMax)) + "...'";
 }
 
-// The command's output as lines: SOEM ends its cyclic lines with '\r', so '\r' ends a line
-// too; empty lines are left out.
-std::vector<std::string> outputLines(const std::string& text) {
-  std::vector<std::string> lines;
-  std::string line;
-  for (char c : text) {
-    if (c == '\n' || c == '\r') {
-      if (!line.empty()) lines.push_back(std::move(line));
-      line.clear();
-    } else {
-      line += c;
+struct StampedLine {
+  SimTime at{0};  // RealClock time the line was first seen complete
+  std::string text;
+};
+
+// Reads the command's output file while it grows and stamps each line with the time it was
+// first seen. SOEM ends its cyclic lines with '\r', so '\r' ends a line too; empty lines are
+// left out. A program that buffers its output shows its lines late (stdbuf -oL helps).
+class OutputReader {
+ public:
+  explicit OutputReader(std::filesystem::path path) : path_(std::move(path)) {}
+  void poll(SimTime now) {
+    if (!fd_.valid()) {
+      fd_ = UniqueFd(::open(path_.c_str(), O_RDONLY | O_CLOEXEC));
+      if (!fd_.valid()) return;
+    }
+    std::array<char, 4096> chunk{};
+    for (;;) {
+      const ssize_t n = ::read(fd_.get(), chunk.data(), chunk.size());
+      if (n <= 0) break;
+      for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) {
+        const char c = chunk[i];
+        if (c == '\n' || c == '\r') {
+          endLine(now);
+        } else {
+          pending_ += c;
+        }
+      }
     }
   }
-  if (!line.empty()) lines.push_back(std::move(line));
-  return lines;
-}
+  // Reads what is left; a last line without its end counts too.
+  void finish(SimTime now) {
+    poll(now);
+    endLine(now);
+  }
+  const std::vector<StampedLine>& lines() const { return lines_; }
+
+ private:
+  void endLine(SimTime now) {
+    if (!pending_.empty()) lines_.push_back({now, std::move(pending_)});
+    pending_.clear();
+  }
+  std::filesystem::path path_;
+  UniqueFd fd_;
+  std::string pending_;
+  std::vector<StampedLine> lines_;
+};
 
 // Counts the frames that carry process data (LRW, LRD or LWR) on their way in: an external
 // master's cycles as the simulator sees them. Used by the server's thread only.
@@ -165,8 +196,8 @@ class ExternalRun {
   std::vector<LogEntry> log_;
   std::optional<int> exitStatus_;
   std::string exitHow_;
-  std::string output_;
-  std::size_t outputLineCount_{0};
+  SimTime commandStart_{0};
+  std::vector<StampedLine> output_;
 };
 
 bool ExternalRun::allOp() const {
@@ -323,21 +354,38 @@ ExpectationResult ExternalRun::evaluateCommand(const Expectation& x, SimTime at)
   }
   std::optional<std::regex> re;
   if (x.isRegex) re.emplace(x.text, std::regex::ECMAScript);  // checked when the file was read
+  const SimTime zero = zero_.load();
+  if (x.afterTime && zero == kNoTime) {
+    res.observed = "the network never had all slaves in OP: no time zero to count afterMs from";
+    return res;
+  }
   std::size_t found = 0;
-  std::string first;
-  for (const auto& line : outputLines(output_)) {
-    const bool hit = re ? std::regex_search(line, *re) : line.find(x.text) != std::string::npos;
-    if (!hit) continue;
-    if (found++ == 0) first = line;
+  const StampedLine* first = nullptr;
+  for (const auto& line : output_) {
+    if (x.afterTime &&
+        (line.at - zero < *x.afterTime || line.at - zero > *x.afterTime + x.within)) {
+      continue;
+    }
+    if (re ? !std::regex_search(line.text, *re) : line.text.find(x.text) == std::string::npos) {
+      continue;
+    }
+    if (found++ == 0) first = &line;
   }
   if (x.countLines) {
     res.passed = compareValues(static_cast<double>(found), x.compare, x.value, x.tolerance);
   } else {
     res.passed = found > 0;
   }
-  res.observed = found == 0 ? fmt::format("not found in {} lines of output", outputLineCount_)
-                            : fmt::format("{} of {} lines, the first {}", found, outputLineCount_,
-                                          excerpt(first));
+  const std::string window = x.afterTime ? fmt::format(" seen from {} to {}", ms(*x.afterTime),
+                                                       ms(*x.afterTime + x.within))
+                                         : std::string();
+  if (first == nullptr) {
+    res.observed = fmt::format("not found in the {} lines of output{}", output_.size(), window);
+  } else {
+    const SimTime origin = zero == kNoTime ? commandStart_ : zero;
+    res.observed = fmt::format("{} of {} lines{}, the first at {}: {}", found, output_.size(),
+                               window, ms(first->at - origin), excerpt(first->text));
+  }
   return res;
 }
 
@@ -484,7 +532,11 @@ ScenarioResult ExternalRun::execute() {
     outputFile = std::filesystem::temp_directory_path() /
                  fmt::format("ecsim-{}-{}.output.txt", s_.name, ::getpid());
   }
+  std::error_code ignored;
+  std::filesystem::remove(outputFile, ignored);  // no line of an earlier run is read
+  OutputReader reader(outputFile);
   const SimTime start = clock_.now();
+  commandStart_ = start;
   if (s_.timeFromStart) zero_ = start;
   auto child = ns->spawn({"/bin/sh", "-c", *command},
                          SpawnOptions{outputFile.string(), outputFile.string()});
@@ -521,6 +573,7 @@ ScenarioResult ExternalRun::execute() {
                             number(static_cast<double>(s_.startTimeout) / kNsPerMs));
       break;
     }
+    reader.poll(now);
     std::this_thread::sleep_for(kPollInterval);
   }
   if (!exitStatus_) {
@@ -540,22 +593,17 @@ ScenarioResult ExternalRun::execute() {
   thread.join();
   if (writer) (void)writer->close();
 
-  std::ifstream in(outputFile, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  output_ = text.str();
-  in.close();
-  if (!keepOutput) std::filesystem::remove(outputFile);
-  const auto lines = outputLines(output_);
-  outputLineCount_ = lines.size();
+  reader.finish(end);
+  output_ = reader.lines();
+  if (!keepOutput) std::filesystem::remove(outputFile, ignored);
 
   if (!schedulingNote_.empty()) log(start, "note: " + schedulingNote_);
   finish(end, endText);
-  r_.log.push_back(fmt::format("  output: last {} of {} lines{}",
-                               std::min(e_.tailLines, lines.size()), lines.size(),
+  const std::size_t tail = std::min(e_.tailLines, output_.size());
+  r_.log.push_back(fmt::format("  output: last {} of {} lines{}", tail, output_.size(),
                                keepOutput ? ", all in " + outputFile.string() : ""));
-  for (std::size_t i = lines.size() - std::min(e_.tailLines, lines.size()); i < lines.size(); ++i) {
-    r_.log.push_back("    | " + lines[i]);
+  for (std::size_t i = output_.size() - tail; i < output_.size(); ++i) {
+    r_.log.push_back("    | " + output_[i].text);
   }
   if (interrupted) {
     r_.error = fmt::format("interrupted by signal {} ({}): the command was stopped",

@@ -69,8 +69,12 @@ std::string Expectation::describe() const {
     case ExpectKind::kExitStatus:
       return fmt::format("ExitStatus {}", cmp);
     case ExpectKind::kOutput:
-      return fmt::format("Output {} \"{}\"{}", isRegex ? "matches" : "contains", text,
-                         countLines ? fmt::format(" in {} lines", cmp) : std::string());
+      return fmt::format("Output {} \"{}\"{}{}", isRegex ? "matches" : "contains", text,
+                         countLines ? fmt::format(" in {} lines", cmp) : std::string(),
+                         afterTime ? fmt::format(" within {:.3f} ms after {:.3f} ms",
+                                                 static_cast<double>(within) / kNsPerMs,
+                                                 static_cast<double>(*afterTime) / kNsPerMs)
+                                   : std::string());
   }
   return "?";
 }

@@ -62,9 +62,9 @@ struct Expectation {
   std::optional<std::uint16_t> code;  // kState: AL status code
   std::string condition;              // kDetected
   std::uint64_t afterCycle{0};        // kDetected, kBackInOp
-  std::optional<SimTime> afterTime;   // kBackInOp (afterMs; external masters only)
+  std::optional<SimTime> afterTime;   // kBackInOp, kOutput (afterMs; external masters only)
   std::uint64_t withinCycles{0};      // kDetected
-  SimTime within{0};                  // kBackInOp
+  SimTime within{0};                  // kBackInOp, kOutput
   std::uint16_t address{0};           // kRegister
   unsigned width{1};                  // kRegister bytes
   std::uint32_t mask{0xFFFFFFFF};     // kRegister: bits compared

@@ -175,6 +175,12 @@ Result<Expectation> readExpectation(const Reader& r, const XMLElement* e) {
           (contains ? *contains : *matches).empty()) {
         return r.error(e, "Output needs exactly one of contains=\"TEXT\" and matches=\"REGEX\"");
       }
+      ECSIM_ASSIGN_OR_RETURN(x.afterTime, r.millis(e, "afterMs"));
+      ECSIM_ASSIGN_OR_RETURN(auto within, r.millis(e, "withinMs"));
+      if (x.afterTime.has_value() != within.has_value()) {
+        return r.error(e, "Output takes afterMs and withinMs together");
+      }
+      x.within = within.value_or(0);
       x.isRegex = matches.has_value();
       x.text = contains ? *contains : *matches;
       x.countLines = value.has_value();

@@ -38,6 +38,7 @@ TEST(ExternalScenarioFile, ReadsCommandExpectationsAndTimeouts) {
            "  <Output matches=\"^Processdata cycle +[0-9]+, WKC 10 \" op=\"ge\" value=\"9900\"/>\n"
            "  <BackInOp afterMs=\"2000\" withinMs=\"500\"/>\n"
            "  <State slave=\"DI1\" state=\"OP\" cycle=\"40\"/>\n"
+           "  <Output contains=\"lost\" afterMs=\"1000\" withinMs=\"250\"/>\n"
            "</Expect>\n"),
       "/x/e.xml");
   ASSERT_TRUE(s.ok()) << s.error().message();
@@ -47,7 +48,7 @@ TEST(ExternalScenarioFile, ReadsCommandExpectationsAndTimeouts) {
   EXPECT_EQ(s->startTimeout, 5 * kNsPerSecond);
   EXPECT_EQ(s->stopGrace, 250 * kNsPerMs);
   EXPECT_TRUE(s->timeFromStart);
-  ASSERT_EQ(s->expectations.size(), 5u);
+  ASSERT_EQ(s->expectations.size(), 6u);
   const auto& exit = s->expectations[0];
   EXPECT_EQ(exit.kind, ExpectKind::kExitStatus);
   EXPECT_EQ(exit.line, 5);
@@ -70,6 +71,10 @@ TEST(ExternalScenarioFile, ReadsCommandExpectationsAndTimeouts) {
   EXPECT_EQ(*back.afterTime, 2000 * kNsPerMs);
   EXPECT_EQ(back.describe(), "BackInOp within 500.000 ms after 2000.000 ms");
   EXPECT_EQ(s->expectations[4].atCycle, 40u);
+  const auto& window = s->expectations[5];
+  EXPECT_EQ(window.afterTime, 1000 * kNsPerMs);
+  EXPECT_EQ(window.within, 250 * kNsPerMs);
+  EXPECT_EQ(window.describe(), "Output contains \"lost\" within 250.000 ms after 1000.000 ms");
 }
 
 TEST(ExternalScenarioFile, DefaultsTimeZeroAtOpAndTimeouts) {
@@ -143,6 +148,7 @@ TEST(ExternalScenarioFile, ErrorsInTheAdditionsNameTheLine) {
       {"<ExitStatus/>", "ExitStatus needs value"},
       {"<ExitStatus value=\"0\" atMs=\"5\"/>", "checked when the command has ended"},
       {"<BackInOp afterCycle=\"1\" afterMs=\"5\" withinMs=\"5\"/>", "not both"},
+      {"<Output contains=\"a\" afterMs=\"5\"/>", "afterMs and withinMs together"},
   };
   for (const auto& [element, message] : bad) {
     auto s = parseScenario(wrap(kExternal, "<Expect>\n" + element + "\n</Expect>\n"), "x.xml");

@@ -92,7 +92,7 @@ TEST_F(ExternalScenario, AFailingCommandGivesAFailingReportNamingTheExpectation)
   EXPECT_NE(report.find(": exit status 1\n"), std::string::npos) << report;
   EXPECT_NE(report.find("FAIL  t.xml, line 6: Output contains \"slaves found\""), std::string::npos)
       << report;
-  EXPECT_NE(report.find("not found in 0 lines of output"), std::string::npos) << report;
+  EXPECT_NE(report.find("not found in the 0 lines of output"), std::string::npos) << report;
   EXPECT_NE(report.find("the command exited with status 1"), std::string::npos) << report;
   EXPECT_NE(report.find("never had all slaves in OP"), std::string::npos) << report;
   const std::string junit = formatJunit({r});
@@ -120,6 +120,29 @@ TEST_F(ExternalScenario, TheCommandSeesItsInterfaceAndItsOutputIsJudged) {
   EXPECT_TRUE(r.passed()) << formatReport(r);
   EXPECT_NE(readText(dir_ / "t.output.txt").find("done bird"), std::string::npos);
   expectNoNamespaceLeft();
+}
+
+TEST_F(ExternalScenario, OutputLinesAreJudgedByWhenTheyAppeared) {
+  ECSIM_REQUIRE_NETWORK();
+  auto s = write(
+      "<Master kind=\"external\" timeZero=\"start\" command=\"echo early; sleep 0.4; echo "
+      "late\"/>",
+      "<Output contains=\"late\" afterMs=\"250\" withinMs=\"1000\"/>\n"
+      "<Output contains=\"early\" afterMs=\"250\" withinMs=\"1000\" op=\"eq\" value=\"0\"/>\n"
+      "<Output contains=\"early\" afterMs=\"0\" withinMs=\"250\"/>\n"
+      "<Output contains=\"late\" afterMs=\"0\" withinMs=\"250\"/>\n",
+      "durationMs=\"5000\"");
+  auto r = runExternalScenario(s);
+  ASSERT_TRUE(r.error.empty()) << r.error;
+  ASSERT_EQ(r.results.size(), 4u);
+  EXPECT_TRUE(r.results[0].passed) << r.results[0].observed;
+  EXPECT_TRUE(r.results[1].passed) << r.results[1].observed;
+  EXPECT_TRUE(r.results[2].passed) << r.results[2].observed;
+  EXPECT_FALSE(r.results[3].passed) << r.results[3].observed;
+  EXPECT_NE(r.results[3].observed.find("not found in the 2 lines of output seen from 0.000 ms to "
+                                       "250.000 ms"),
+            std::string::npos)
+      << r.results[3].observed;
 }
 
 TEST_F(ExternalScenario, ACommandStillRunningAtTheEndIsStopped) {
