@@ -5,6 +5,7 @@
 #include "protocol/sdo_info.hpp"
 #include "slavesim/al_state_machine.hpp"
 #include "slavesim/coe/sdo_access.hpp"
+#include "slavesim/coe/standard_objects.hpp"
 
 namespace ecsim::slavesim::coe {
 namespace {
@@ -189,8 +190,46 @@ void CoeServer::sendSdoInfo(SdoInfoOpcode opcode, ConstBytes serviceData) {
 std::uint32_t CoeServer::store(Esc& esc, std::uint16_t index, std::uint8_t subindex,
                                bool completeAccess, ConstBytes data) {
   const AlState state = AlStateMachine::state(esc);
+  if (!completeAccess && subindex >= 1 &&
+      (index == kStoreParametersIndex || index == kRestoreDefaultsIndex)) {
+    if (const Entry* e = od_->findEntry(index, subindex); e != nullptr && e->writable(state)) {
+      return storeParameters(index, subindex, data);
+    }
+  }
   return completeAccess ? sdoWriteComplete(*od_, index, subindex, data, state)
                         : sdoWrite(*od_, index, subindex, data, state);
+}
+
+// CiA 301 §7.5.2.13/14: "save" (0x65766173) written to 0x1010:n, "load" (0x64616F6C) to
+// 0x1011:n; sub 1 all parameters, 2 communication (0x1000-0x1FFF), 3 application
+// (0x6000-0x9FFF), 4 and up manufacturer (0x2000-0x5FFF). The entry itself is not written (it
+// reads the device's capabilities); any other value is refused.
+std::uint32_t CoeServer::storeParameters(std::uint16_t index, std::uint8_t subindex,
+                                         ConstBytes data) {
+  constexpr std::uint32_t kSave = 0x65766173;
+  constexpr std::uint32_t kLoad = 0x64616F6C;
+  const std::uint32_t signature = index == kStoreParametersIndex ? kSave : kLoad;
+  if (data.size() != 4 || readLe32(data, 0) != signature) {
+    return code(SdoAbortCode::kDataCannotBeTransferred);
+  }
+  std::uint16_t first = 0x0000;
+  std::uint16_t last = 0xFFFF;
+  if (subindex == 2) {
+    first = 0x1000;
+    last = 0x1FFF;
+  } else if (subindex == 3) {
+    first = 0x6000;
+    last = 0x9FFF;
+  } else if (subindex >= 4) {
+    first = 0x2000;
+    last = 0x5FFF;
+  }
+  if (index == kStoreParametersIndex) {
+    od_->storePowerUpValues(first, last);
+  } else {
+    od_->defaultPowerUpValues(first, last);
+  }
+  return kSdoOk;
 }
 
 void CoeServer::handleSdo(Esc& esc, ConstBytes body) {

@@ -19,6 +19,10 @@
 //     asks with 0x07 and gets the name right after the access word);
 //   - emergencies: pushEmergency() queues; queued messages go out one at a time whenever SM1
 //     is free (responses and emergencies in the order they were queued).
+//   - store / restore parameters (CiA 301 0x1010 / 0x1011, when the dictionary has them):
+//     "save" / "load" written to sub n makes the current values / the defaults the power-up
+//     values of the objects that sub covers (ObjectDictionary::storePowerUpValues), so they
+//     survive (or are reset by) the next power cycle; another value aborts 0x08000020.
 // When the mailbox SyncManagers are switched off (INIT, a master resetting the slave) every
 // pending transfer, queued message and the retry memory are dropped.
 #pragma once
@@ -97,6 +101,7 @@ class CoeServer final : public MailboxServer {
   void downloadSegment(Esc& esc, const SdoDownloadSegmentRequest& request);
   std::uint32_t store(Esc& esc, std::uint16_t index, std::uint8_t subindex, bool completeAccess,
                       ConstBytes data);
+  std::uint32_t storeParameters(std::uint16_t index, std::uint8_t subindex, ConstBytes data);
 
   void sendAbort(std::uint16_t index, std::uint8_t subindex, std::uint32_t code);
   void sendSdo(const SdoResponse& response);

@@ -186,6 +186,28 @@ void ObjectDictionary::capturePowerUpValues() {
   }
 }
 
+void ObjectDictionary::storePowerUpValues(std::uint16_t first, std::uint16_t last) {
+  if (!hasPowerUpValues()) capturePowerUpValues();
+  for (auto it = objects_.lower_bound(first); it != objects_.end() && it->first <= last; ++it) {
+    for (const auto& e : it->second.entries) {
+      if (e.writableSomewhere()) {
+        powerUp_[(static_cast<std::uint32_t>(it->first) << 8) | e.subindex] = e.value;
+      }
+    }
+  }
+}
+
+void ObjectDictionary::defaultPowerUpValues(std::uint16_t first, std::uint16_t last) {
+  if (!hasPowerUpValues()) capturePowerUpValues();
+  for (auto it = objects_.lower_bound(first); it != objects_.end() && it->first <= last; ++it) {
+    for (const auto& e : it->second.entries) {
+      if (e.writableSomewhere()) {
+        powerUp_[(static_cast<std::uint32_t>(it->first) << 8) | e.subindex] = e.defaultValue;
+      }
+    }
+  }
+}
+
 void ObjectDictionary::restorePowerUpValues() {
   for (auto& [index, object] : objects_) {
     for (auto& e : object.entries) {

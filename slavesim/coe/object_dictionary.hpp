@@ -137,6 +137,12 @@ class ObjectDictionary {
   void capturePowerUpValues();
   void restorePowerUpValues();
   bool hasPowerUpValues() const { return !powerUp_.empty(); }
+  // CiA 301 0x1010 "store parameters" / 0x1011 "restore default parameters" for the objects
+  // first..last: the current values (storePowerUpValues) or the defaults
+  // (defaultPowerUpValues) of their writable entries become their power-up values, effective
+  // at the next power cycle. Read-only entries keep theirs.
+  void storePowerUpValues(std::uint16_t first, std::uint16_t last);
+  void defaultPowerUpValues(std::uint16_t first, std::uint16_t last);
 
   // ---- building -----------------------------------------------------------------------------
   // A VAR with its value at sub 0 (value zero, default zero).

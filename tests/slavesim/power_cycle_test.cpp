@@ -4,6 +4,7 @@
 // a state file) and input terminals' scripts. Slaves from examples/esi/ecsim_devices.xml.
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <numbers>
 
 #include "slavesim/devices/device_models.hpp"
@@ -95,6 +96,49 @@ TEST(PowerCycle, DriveForgetsSdoAndPdoValuesButKeepsItsMultiTurnPosition) {
   EXPECT_EQ(mode, 8) << "0x6060 back to its ESI default (CSP)";
   EXPECT_EQ(window, 10000u) << "0x6065 downloaded by SDO: back to its default";
   EXPECT_EQ(position, before) << "the multi-turn position survives (no state file)";
+}
+
+// CiA 301 0x1010 "store parameters" / 0x1011 "restore default parameters" (added here: the
+// ECS7201's ESI has neither): what was stored survives the power cycle, until restored.
+TEST(PowerCycle, StoredParametersSurviveUntilDefaultsAreRestored) {
+  topology::Segment seg;
+  seg.addSlave(makeExampleSlave(kEcs7201));
+  slavesim::Slave& slave = seg.slave(0);
+  auto* od = slavesim::objectDictionaryOf(slave);
+  for (std::uint16_t index :
+       {slavesim::coe::kStoreParametersIndex, slavesim::coe::kRestoreDefaultsIndex}) {
+    od->addArray(index, "Store/restore", slavesim::coe::data_type::kUnsigned32, 32, 1,
+                 slavesim::coe::access::kReadWrite);
+    ASSERT_TRUE(od->set<std::uint32_t>(index, 1, 1).ok());  // "on command"
+  }
+  const std::vector<std::uint8_t> save = {'s', 'a', 'v', 'e'}, load = {'l', 'o', 'a', 'd'};
+  SimTime now = kNsPerMs;
+  seg.pollSlaves(now);
+  auto inPreOp = [&](const std::function<void(MailboxMaster&)>& f) {
+    bringToOp(seg, {{2, true, 13}, {3, false, 15}}, now, f);
+    powerCycle(slave);
+    now += kNsPerMs;
+  };
+  inPreOp([&](MailboxMaster& m) {
+    EXPECT_EQ(m.download(kFollowingErrorWindow, 0, le32v(2500)), 0u);
+    EXPECT_EQ(m.download(slavesim::coe::kStoreParametersIndex, 1, load), 0x08000020u)
+        << "only \"save\" stores";
+    EXPECT_EQ(m.download(slavesim::coe::kStoreParametersIndex, 3, save), 0x06090011u)
+        << "sub 3 (application parameters) does not exist here";
+    EXPECT_EQ(m.download(slavesim::coe::kStoreParametersIndex, 1, save), 0u);
+    EXPECT_EQ(m.uploadValue<std::uint32_t>(slavesim::coe::kStoreParametersIndex, 1), 1u)
+        << "the entry keeps reading the device's capability";
+    EXPECT_EQ(m.download(kFollowingErrorWindow, 0, le32v(3000)), 0u);  // not stored
+  });
+  inPreOp([&](MailboxMaster& m) {
+    EXPECT_EQ(m.uploadValue<std::uint32_t>(kFollowingErrorWindow, 0), 2500u) << "stored";
+    EXPECT_EQ(m.download(slavesim::coe::kRestoreDefaultsIndex, 1, load), 0u);
+    EXPECT_EQ(m.uploadValue<std::uint32_t>(kFollowingErrorWindow, 0), 2500u)
+        << "restored only at the next power-up";
+  });
+  inPreOp([&](MailboxMaster& m) {
+    EXPECT_EQ(m.uploadValue<std::uint32_t>(kFollowingErrorWindow, 0), 10000u) << "default";
+  });
 }
 
 TEST(PowerCycle, DriveFaultAndCiA402StateAreForgotten) {
