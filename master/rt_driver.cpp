@@ -140,6 +140,10 @@ void RtDriver::stop() {
     if (t->joinable()) t->join();
   }
   takeSnapshot();
+  {
+    std::lock_guard<PiMutex> lock(masterLock_);
+    posted_.clear();  // their datagrams are withdrawn from the transport
+  }
   running_ = false;
   if (memoryLocked_) munlockall();
 }
@@ -277,10 +281,31 @@ void RtDriver::controlLoop() {
       ++controlSteps_;
       nextControl = now + options_.controlPeriod;
     }
+    if (newCycle) stepPosted();
     if (now >= nextSnapshot) {
       takeSnapshot();
       nextSnapshot +=
           ((now - nextSnapshot) / options_.snapshotPeriod + 1) * options_.snapshotPeriod;
+    }
+  }
+}
+
+Status RtDriver::post(AcyclicStep step) {
+  if (!running_.load() || stopping_.load()) {
+    return makeError(ErrorCode::kState, "the real-time driver is not running");
+  }
+  std::lock_guard<PiMutex> lock(masterLock_);
+  posted_.push_back(std::move(step));
+  return okStatus();
+}
+
+void RtDriver::stepPosted() {
+  std::lock_guard<PiMutex> lock(masterLock_);
+  for (std::size_t i = 0; i < posted_.size();) {
+    if (posted_[i](master_, lastFinish_)) {
+      ++i;
+    } else {
+      posted_.erase(posted_.begin() + static_cast<std::ptrdiff_t>(i));
     }
   }
 }

@@ -10,9 +10,10 @@
 //                 Master::control(), i.e. the state machines: AL status reads, lost and
 //                 returning slaves, one recovery step; the datagrams it queues go out with the
 //                 next cyclic send, as IgH's master thread queues datagrams that the
-//                 application's send carries. Every snapshotPeriod it copies statistics,
-//                 health and new events into a snapshot for the non-real-time world (a UI, a
-//                 logger), so that nothing outside these threads touches the master while it
+//                 application's send carries. Then it steps the acyclic tasks posted while
+//                 running (an SDO, a register read: post()). Every snapshotPeriod it copies
+//                 statistics, health and new events into a snapshot for the non-real-time world (a
+//                 UI, a logger), so that nothing outside these threads touches the master while it
 //                 runs
 //   cyclic task   sleeps with clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME) to the next
 //                 period, measures how late it woke, runs the application (outputs from
@@ -38,6 +39,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -126,6 +128,23 @@ class RtDriver {
 
   RtSnapshot snapshot() const;
 
+  // Acyclic work while the driver runs (an SdoTask, a register read): the control thread calls
+  // `step` after each control step, under the master lock, until it returns false. It starts
+  // and steps its tasks there (on master.transport()); their datagrams go out with the next
+  // cycles. `step` is destroyed on the control thread too, under the lock, so that the tasks it
+  // owns never touch the transport outside it. Returns at once; kState when the driver is not
+  // running. Work still unfinished at stop() is destroyed unfinished.
+  //
+  //   auto sdo = std::make_shared<SdoTask>(master.transport(), slave, nullptr);
+  //   driver.post([sdo, started = false](Master&, SimTime now) mutable {
+  //     if (!std::exchange(started, true)) (void)sdo->startUpload(0x1018, 1, false, now);
+  //     if (sdo->step(now)) return true;
+  //     ... sdo->status(), sdo->data() ...
+  //     return false;
+  //   });
+  using AcyclicStep = std::function<bool(Master& master, SimTime now)>;
+  Status post(AcyclicStep step);
+
  private:
   void sendReceiveLoop();
   void controlLoop();
@@ -133,6 +152,7 @@ class RtDriver {
   // One cycle's I/O: send, poll until answered (waiting on the bus unlocked), finish.
   Status exchangeOnce();
   void takeSnapshot();
+  void stepPosted();  // the control thread, after a cycle
   // Starts `loop` on `thread`, names it, asks for SCHED_FIFO `priority`: 0 or the error
   // number; a failed pinning is a warning.
   int spawn(std::thread& thread, int priority, void (RtDriver::*loop)(), const char* name);
@@ -150,7 +170,8 @@ class RtDriver {
   SimTime lastFinish_{0};  // when send/receive finished the last cycle (bus clock)
   std::uint64_t controlSteps_{0};
   LatencyHistogram wakeLatency_;
-  std::size_t eventsCopied_{0};  // of master_.events(), into snapshot_
+  std::size_t eventsCopied_{0};      // of master_.events(), into snapshot_
+  std::vector<AcyclicStep> posted_;  // acyclic work, stepped by the control thread
 
   std::mutex handoffLock_;  // the hand-offs between the threads
   std::condition_variable handoff_;

@@ -1,7 +1,7 @@
 // The real-time driver's three threads against the demo network served by its own thread on
 // real time (tests/master/rt_driver_network.hpp): their names, policies and priorities as the
 // kernel reports them, pinning to one CPU, recovery stepped by the control thread (and not by
-// send/receive), and a clean stop.
+// send/receive), an SDO posted while running, and a clean stop.
 #include <gtest/gtest.h>
 #include <sched.h>
 
@@ -9,9 +9,11 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <set>
 #include <thread>
 
+#include "master/coe_client.hpp"
 #include "master/rt_driver.hpp"
 #include "tests/master/bring_up.hpp"
 #include "tests/master/rt_driver_network.hpp"
@@ -223,6 +225,49 @@ TEST_F(RtDriverThreadsTest, SendReceiveAloneDoesNoHealthWork) {
       20))
       << eventLog(again.snapshot());
   again.stop();
+}
+
+TEST_F(RtDriverThreadsTest, AnSdoPostedWhileRunningIsSteppedByTheControlThread) {
+  master::RtDriver driver(*master_, options());
+  master::SlaveInfo drive = master_->slaves()[kDrive];  // the task's own record
+  ASSERT_TRUE(drive.hasCoe());
+  EXPECT_FALSE(driver.post([](master::Master&, SimTime) { return false; }).ok());  // not running
+  ASSERT_TRUE(driver.start().ok());
+  ASSERT_TRUE(waitFor(
+      driver, [](const master::RtSnapshot& s) { return s.cycles >= 20; }, 20));
+  struct Outcome {
+    Status status;
+    std::vector<std::uint8_t> data;
+    std::string thread;
+    std::uint64_t steps{0};
+  };
+  std::promise<Outcome> promise;
+  auto result = promise.get_future();
+  auto sdo = std::make_shared<master::SdoTask>(master_->transport(), drive, nullptr);
+  ASSERT_TRUE(driver
+                  .post([sdo, &promise, started = false, steps = std::uint64_t{0}](
+                            master::Master&, SimTime now) mutable {
+                    ++steps;
+                    if (!std::exchange(started, true)) {
+                      (void)sdo->startUpload(0x1018, 1, false, now);  // identity: vendor id
+                    }
+                    if (sdo->step(now)) return true;
+                    char name[16] = {};
+                    pthread_getname_np(pthread_self(), name, sizeof(name));
+                    promise.set_value({sdo->status(), sdo->data(), name, steps});
+                    return false;
+                  })
+                  .ok());
+  ASSERT_EQ(result.wait_for(std::chrono::seconds(20)), std::future_status::ready);
+  const Outcome out = result.get();
+  driver.stop();
+  ASSERT_TRUE(out.status.ok()) << out.status.error().message();
+  ASSERT_EQ(out.data.size(), 4u);
+  EXPECT_EQ(readLe32(out.data, 0), drive.identity().vendorId);
+  EXPECT_EQ(out.thread, "ec-control");
+  EXPECT_GE(out.steps, 2u);  // a mailbox write and a read: at least two cycles
+  const auto s = driver.snapshot();
+  EXPECT_EQ(s.failedCycles, 0u) << s.firstError;  // the cycle went on meanwhile
 }
 
 }  // namespace
