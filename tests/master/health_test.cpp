@@ -8,8 +8,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <fstream>
 #include <random>
 
+#include "config/eni.hpp"
 #include "master/health.hpp"
 #include "master/histogram.hpp"
 #include "master/master.hpp"
@@ -394,6 +396,58 @@ TEST_F(RecoveryFailureTest, EepromChecksumErrorIsReportedOnceAndTheOthersKeepRun
   EXPECT_EQ(esc.reg16(reg::kConfiguredStationAddress.address), 0x1004);
   EXPECT_EQ(run(200), 0u);
   EXPECT_EQ(sim(kDrive).state(), AlState::kOp);
+}
+
+// A master configured from examples/eni/demo-eni.xml: a power-cycled AI1 gets its ENI init
+// commands again - the PS register write of its process-data watchdog (changed here to 500, so
+// that the ESC's power-on default of 1000 does not pass for it) and the PS CoE download
+// 0x8000:01 (the filter of channel 1).
+TEST(EniRecoveryTest, PowerCycledSlaveGetsItsEniInitCommandsAgain) {
+  SimNetwork net;
+  net.segment().addSlave(makeDemoSlave(0x1100, "Coupler"));
+  net.segment().addSlave(makeDemoSlave(0x1008, "DI1"));
+  net.segment().addSlave(makeDemoSlave(0x2008, "DO1"));
+  net.segment().addSlave(makeDemoSlave(0x3102, "AI1"));
+  net.segment().addSlave(makeDemoSlave(0x7201, "Drive1"));
+  net.segment().addSlave(makeDemoSlave(0x7201, "Drive2"));
+  net.segment().wireLine();
+  net.start();
+  std::ifstream in(std::string(ECSIM_SOURCE_DIR) + "/examples/eni/demo-eni.xml");
+  std::string xml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto ai = xml.find("<Name>AI1</Name>");
+  ASSERT_NE(ai, std::string::npos);
+  const auto watchdog = xml.find("<Data>E803</Data>", ai);  // 0x0420 = 1000
+  ASSERT_NE(watchdog, std::string::npos);
+  xml.replace(watchdog, 17, "<Data>F401</Data>");  // 500
+  auto eni = parseEni(xml, "demo-eni.xml");
+  ASSERT_TRUE(eni.ok()) << eni.error().message();
+  master::Master master(net.masterLink(), net.bus());
+  master.setConfig(masterConfigFromEni(std::move(eni).value()));
+  auto started = master.start();
+  ASSERT_TRUE(started.ok()) << started.error().message();
+  auto& aiSim = net.segment().slave(kAi);
+  constexpr std::uint16_t kWatchdogTime = 0x0420;
+  ASSERT_EQ(aiSim.esc().reg16(kWatchdogTime), 500);
+  auto watched = std::make_unique<WatchedMailbox>(aiSim.takeMailboxServer());
+  WatchedMailbox& mailbox = *watched;
+  aiSim.setMailboxServer(std::move(watched));
+  aiSim.powerOff();
+  aiSim.powerOn();
+  ASSERT_EQ(aiSim.esc().reg16(kWatchdogTime), 1000);
+  bool back = false;
+  for (int i = 0; i < 3000 && !back; ++i) {
+    const SimTime next = net.clock().now() + kNsPerMs;
+    (void)master.cycle();
+    while (net.clock().now() < next) net.bus().wait(next);
+    back = master.health().allOperational() && aiSim.state() == AlState::kOp;
+  }
+  std::string log;
+  for (const auto& e : master.events()) log += e.text + "\n";
+  ASSERT_TRUE(back) << log;
+  EXPECT_EQ(aiSim.esc().reg16(kWatchdogTime), 500) << log;
+  EXPECT_EQ(mailbox.downloads, (std::vector<std::pair<std::uint16_t, std::uint8_t>>{{0x8000, 1}}))
+      << "the ENI's own commands, not the master's PDO assignment";
+  EXPECT_EQ(aiSim.esc().reg16(reg::kConfiguredStationAddress.address), 1004);  // the ENI's
 }
 
 // ---- SlaveSetup ----------------------------------------------------------------------------
