@@ -8,9 +8,12 @@
 #include <filesystem>
 #include <numbers>
 
+#include "config/topology_file.hpp"
 #include "slavesim/devices/device_models.hpp"
 #include "tests/slavesim/drive_test_support.hpp"
 #include "tests/support/test_network.hpp"
+#include "topology/faults.hpp"
+#include "topology/network_builder.hpp"
 
 namespace ecsim::testing {
 namespace {
@@ -190,6 +193,49 @@ TEST(EncoderTerminal, StateFileKeepsThePositionAcrossARestart) {
   n.toOp();
   EXPECT_EQ(n.counter(), asCounter(-12.125 * kCpr));
   std::filesystem::remove_all(dir);
+}
+
+// The scenario action `encoder-fault` on the encoder terminal of
+// examples/topologies/encoder_line.xml: kinds, clearing, errors; the topology's shaft angle.
+TEST(EncoderTerminal, EncoderFaultActionSetsAndClearsTheTerminalsFaults) {
+  auto config = loadTopologyFile(std::filesystem::path(ECSIM_SOURCE_DIR) / "examples" /
+                                 "topologies" / "encoder_line.xml");
+  ASSERT_TRUE(config.ok()) << config.error().message();
+  auto net = topology::buildNetwork(*config);
+  ASSERT_TRUE(net.ok()) << net.error().message();
+  topology::FaultInjector faults(*net, 1);
+  auto index = faults.slaveIndex("Encoder1");
+  ASSERT_TRUE(index.ok());
+  slavesim::Slave& slave = net->segment->slave(*index);
+  dev::SsiEncoderTerminal* t = dev::encoderTerminalOf(slave);
+  ASSERT_NE(t, nullptr);
+  net->segment->pollSlaves(kNsPerMs);
+  EXPECT_EQ(*slavesim::objectDictionaryOf(slave)->get<std::uint32_t>(0x6000, 0x11), 327680u)
+      << "2.5 turns (drive.initialShaftAngle in the topology)";
+  auto apply = [&](const std::string& line) {
+    auto action = topology::parseFaultAction(line);
+    EXPECT_TRUE(action.ok());
+    return faults.apply(*action, kNsPerMs);
+  };
+  ASSERT_TRUE(apply("encoder-fault slave=Encoder1").ok());
+  EXPECT_EQ(t->fault(1), ef::kData) << "data is the default kind";
+  ASSERT_TRUE(apply("encoder-fault slave=Encoder1 kind=frame").ok());
+  EXPECT_EQ(t->fault(1), ef::kData | ef::kFrame);
+  ASSERT_TRUE(apply("encoder-fault slave=Encoder1 kind=data on=0").ok());
+  EXPECT_EQ(t->fault(1), ef::kFrame);
+  EXPECT_FALSE(apply("encoder-fault slave=Encoder1 kind=noise").ok());
+  EXPECT_FALSE(apply("encoder-fault slave=Encoder1 channel=2").ok()) << "one channel";
+  EXPECT_FALSE(apply("encoder-fault slave=DO1").ok()) << "neither encoder nor drive";
+  ASSERT_TRUE(apply("power-cycle slave=Encoder1").ok());
+  t = dev::encoderTerminalOf(slave);
+  ASSERT_NE(t, nullptr);
+  EXPECT_EQ(t->fault(1), ef::kFrame) << "the fault is outside the terminal";
+  ASSERT_TRUE(apply("input slave=Encoder1 channel=1 signal=-1").ok()) << "the shaft, in turns";
+  net->segment->pollSlaves(2 * kNsPerMs);
+  ASSERT_TRUE(apply("encoder-fault slave=Encoder1 kind=frame on=0").ok());
+  net->segment->pollSlaves(3 * kNsPerMs);
+  EXPECT_EQ(*slavesim::objectDictionaryOf(slave)->get<std::uint32_t>(0x6000, 0x11),
+            asCounter(-kCpr));
 }
 
 // The real EJ5002 (two SSI channels): its ESI gives the dictionary, our model fills it.
