@@ -11,6 +11,7 @@ Slave::Slave(std::string name, const EscType& type, std::vector<std::uint8_t> si
 
 void Slave::powerOn() {
   esc_.powerOnReset();
+  esm_ = AlStateMachine{};  // the firmware's own state starts over too
   powered_ = true;
   firmwareRunning_ = (esc_.reg16(reg::kDlStatus.address) & reg::dl_status::kPdiOperational) != 0;
   started_ = true;  // the power-up state was taken at the first start (or is taken now)

@@ -20,7 +20,8 @@
 //   encoder-fault slave=S [kind=data|frame|power] [on=0|1] [channel=N]
 //                                   an encoder terminal's fault (status bits, position
 //                                   frozen; on=0 clears it); on a drive: fault 0x7305
-//   input slave=S channel=N signal=TEXT    scripted input (slavesim/devices/signal.hpp)
+//   input slave=S channel=N signal=TEXT    scripted input (slavesim/devices/signal.hpp); on an
+//                                   encoder terminal the shaft position in turns
 //
 // Random decisions come from a SplitMix64 generator seeded by the caller: the same seed and the
 // same frames give the same faults.
