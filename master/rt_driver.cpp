@@ -213,6 +213,7 @@ Status RtDriver::exchangeOnce() {
   {
     std::lock_guard<PiMutex> lock(masterLock_);
     if (Status s = master_.sendCycle(now); !s.ok()) return s;
+    now = bus.now();  // an answer's round trip is measured from the send to this poll's time
     pending = master_.pollCycle(now);
   }
   while (pending && now < deadline) {
