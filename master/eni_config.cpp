@@ -466,6 +466,7 @@ Result<ProcessImageLayout> planEniLayout(const EniConfig& eni, const std::vector
         if (add == 0) continue;
         computed += add;
         d.slaves.push_back(sl.position);
+        d.contributions.push_back(static_cast<std::uint16_t>(add));
       }
     } else {
       const std::uint16_t adp = c.adp.value_or(0);
@@ -480,9 +481,11 @@ Result<ProcessImageLayout> planEniLayout(const EniConfig& eni, const std::vector
              static_cast<std::uint16_t>(0x10000u - adp) == s.position) ||
             (addressMode(p.command) == AddressMode::kConfigured && s.station == adp);
         if (!addressed) continue;
-        d.slaves.push_back(s.position);
-        computed +=
+        const std::uint32_t add =
             everySlave && !(addressMode(p.command) == AddressMode::kBroadcast) ? 1u : perSlave;
+        d.slaves.push_back(s.position);
+        d.contributions.push_back(static_cast<std::uint16_t>(add));
+        computed += add;
       }
     }
     if (c.cnt) {

@@ -69,6 +69,22 @@ EniPdo pdoOf(const PdoInfo& pdo, unsigned sm) {
   return p;
 }
 
+// LogicalDatagram::states as an ENI <State> list; a datagram sent in every state is written
+// for the states cyclic frames run in.
+std::string statesText(std::uint8_t states) {
+  if (states == kAllStates) return "SAFEOP OP";
+  std::string text;
+  for (const auto& [state, name] :
+       {std::pair{AlState::kInit, "INIT"}, std::pair{AlState::kPreOp, "PREOP"},
+        std::pair{AlState::kSafeOp, "SAFEOP"}, std::pair{AlState::kOp, "OP"},
+        std::pair{AlState::kBootstrap, "BOOT"}}) {
+    if ((states & stateBit(state)) == 0) continue;
+    if (!text.empty()) text += ' ';
+    text += name;
+  }
+  return text;
+}
+
 }  // namespace
 
 std::optional<unsigned> parentPort(const std::vector<SlaveInfo>& slaves, std::size_t position) {
@@ -157,11 +173,16 @@ EniConfig eniFromMaster(const Master& master) {
   cyclic.frames.resize(layout.frameCount);
   for (const LogicalDatagram& d : layout.datagrams) {
     EniCyclicCmd cmd;
-    cmd.state = "SAFEOP OP";
-    cmd.cmd = static_cast<std::uint8_t>(Command::kLrw);
-    cmd.addr = d.logicalStart;
+    cmd.state = statesText(d.states);
+    cmd.cmd = static_cast<std::uint8_t>(d.command);
+    if (isLogical(d.command)) {
+      cmd.addr = d.logicalStart;
+    } else {  // ADP | ADO << 16 (master/process_image.hpp)
+      cmd.adp = static_cast<std::uint16_t>(d.logicalStart & 0xFFFFu);
+      cmd.ado = static_cast<std::uint16_t>(d.logicalStart >> 16);
+    }
     cmd.dataLength = d.length;
-    cmd.cnt = d.expectedWkc;
+    if (d.checkWkc) cmd.cnt = d.expectedWkc;
     cmd.inputOffs = frameOffset[d.frame] + 10;
     cmd.outputOffs = frameOffset[d.frame] + 10;
     frameOffset[d.frame] += 10u + d.length + 2u;

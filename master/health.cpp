@@ -8,22 +8,6 @@ namespace {
 constexpr std::uint16_t kAlStatusLength =
     static_cast<std::uint16_t>(reg::kAlStatusCode.end() - reg::kAlStatus.address);
 
-bool overlaps(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1) {
-  return a0 < b1 && b0 < a1;
-}
-
-// The working counter one slave adds to a datagram (the rule of planProcessImage()).
-std::uint16_t contribution(const ProcessImageLayout& layout, const LogicalDatagram& d,
-                           const SlaveLayout& sl) {
-  const std::uint32_t start = d.logicalStart - layout.logicalBase;
-  const std::uint32_t end = start + d.length;
-  const bool out =
-      sl.outputBytes > 0 && overlaps(start, end, sl.outputOffset, sl.outputOffset + sl.outputBytes);
-  const bool in =
-      sl.inputBytes > 0 && overlaps(start, end, sl.inputOffset, sl.inputOffset + sl.inputBytes);
-  return static_cast<std::uint16_t>((out ? 2 : 0) + (in ? 1 : 0));
-}
-
 // Where a recovery starts for a slave that answers at its station address.
 SlaveRecoveryTask::Stage firstStage(const SlaveInfo& slave) {
   switch (slave.state().value_or(AlState::kInit)) {
@@ -304,27 +288,30 @@ void HealthMonitor::startRecovery(std::size_t position, SlaveRecoveryTask::Stage
 }
 
 void HealthMonitor::updateExpectations() {
+  // From the datagram's own expectation (planned, or an ENI's Cnt): a lost slave's share is
+  // taken out, a recovering or failed slave's share may or may not be there.
   for (std::size_t i = 0; i < layout_.datagrams.size(); ++i) {
     const LogicalDatagram& d = layout_.datagrams[i];
-    std::uint16_t sure = 0;
-    std::uint16_t maybe = 0;
-    for (const auto& sl : layout_.slaves) {
-      if (sl.position >= slaves_.size()) continue;
-      const std::uint16_t c = contribution(layout_, d, sl);
-      if (c == 0) continue;
-      switch (slaves_[sl.position].health.condition) {
+    if (!d.checkWkc) continue;
+    std::uint32_t missing = 0;
+    std::uint32_t maybe = 0;
+    for (std::size_t k = 0; k < d.slaves.size() && k < d.contributions.size(); ++k) {
+      if (d.slaves[k] >= slaves_.size()) continue;
+      switch (slaves_[d.slaves[k]].health.condition) {
         case SlaveCondition::kOperational:
-          sure = static_cast<std::uint16_t>(sure + c);
           break;
         case SlaveCondition::kRecovering:
         case SlaveCondition::kFailed:
-          maybe = static_cast<std::uint16_t>(maybe + c);
+          maybe += d.contributions[k];
           break;
         case SlaveCondition::kLost:
+          missing += d.contributions[k];
           break;
       }
     }
-    cyclic_.setExpectedWkc(i, sure, static_cast<std::uint16_t>(sure + maybe));
+    const std::uint32_t most = d.expectedWkc > missing ? d.expectedWkc - missing : 0u;
+    const std::uint32_t least = most > maybe ? most - maybe : 0u;
+    cyclic_.setExpectedWkc(i, static_cast<std::uint16_t>(least), static_cast<std::uint16_t>(most));
   }
 }
 

@@ -130,8 +130,10 @@ Result<ProcessImageLayout> planProcessImage(const std::vector<SlaveInfo>& slaves
       const bool in = sl.inputBytes > 0 && overlaps(range.start, range.end, sl.inputOffset,
                                                     sl.inputOffset + sl.inputBytes);
       if (!out && !in) continue;
-      d.expectedWkc = static_cast<std::uint16_t>(d.expectedWkc + (out ? 2 : 0) + (in ? 1 : 0));
+      const auto add = static_cast<std::uint16_t>((out ? 2 : 0) + (in ? 1 : 0));
+      d.expectedWkc = static_cast<std::uint16_t>(d.expectedWkc + add);
       d.slaves.push_back(sl.position);
+      d.contributions.push_back(add);
     }
     const std::size_t wire = kDatagramOverhead + d.length;
     if (frameUsed + wire > kFrameDatagramCapacity) {

@@ -56,7 +56,8 @@ struct SlaveLayout {
 // AlState values as bits of LogicalDatagram::states.
 constexpr std::uint8_t kAllStates = 0xFF;
 constexpr std::uint8_t stateBit(AlState state) {
-  return static_cast<std::uint8_t>(state);
+  // INIT 1, PREOP 2, SAFEOP 4, OP 8 are bits already; BOOT (3) gets a bit of its own.
+  return state == AlState::kBootstrap ? std::uint8_t{0x10} : static_cast<std::uint8_t>(state);
 }
 
 struct LogicalDatagram {
@@ -65,6 +66,9 @@ struct LogicalDatagram {
   std::uint16_t length{0};
   std::uint16_t expectedWkc{0};
   std::vector<std::size_t> slaves;  // positions of the slaves it touches
+  // What each of `slaves` adds to the working counter (same order): the health monitor takes a
+  // lost slave's share out of the expectation.
+  std::vector<std::uint16_t> contributions;
   std::size_t frame{0};
   // planProcessImage() makes LRWs sent in every state. An ENI's cyclic Cmd may be any command
   // (master/eni_config.hpp): only logical ones exchange image bytes (outputs copied into the

@@ -379,6 +379,45 @@ TEST_F(EniCyclicTest, TwoFramesWithAnLwrAnLrdAndABrdOfAlStatusInOp) {
   EXPECT_EQ(master_->lastCycle().wkcErrors, 1u);
 }
 
+// A slave that disappears takes its own share out of each Cmd's working counter: 1 from the
+// LWR (it was written), 1 from the LRD (it was read), 1 from the BRD; the others keep running
+// clean, and the master exports the Cmds it runs, not LRWs.
+TEST_F(EniCyclicTest, ALostSlaveTakesItsShareOutOfEachCmdAndTheExportKeepsTheCmds) {
+  ASSERT_TRUE(startWith(splitWithAlStatusBrd(exportedEni())).ok());
+  for (int c = 0; c < 100; ++c) ASSERT_TRUE(master_->cycle().ok()) << c;
+  net_.segment().setLinkUp(kDrive, 1, false);  // Drive2, last in the line, is cut off
+  bool lost = false;
+  for (int c = 0; c < 300 && !lost; ++c) {
+    (void)master_->cycle();
+    lost = master_->health().slaves[kDrive2].condition == master::SlaveCondition::kLost;
+  }
+  ASSERT_TRUE(lost);
+  const std::uint64_t errorsBefore = master_->statistics().wkcErrors;
+  for (int c = 0; c < 1000; ++c) {
+    auto s = master_->cycle();
+    ASSERT_TRUE(s.ok()) << c << ": " << s.error().message();
+  }
+  EXPECT_EQ(master_->statistics().wkcErrors, errorsBefore);
+
+  const EniConfig exported = master::eniFromMaster(*master_);
+  ASSERT_EQ(exported.cyclic.size(), 1u);
+  ASSERT_EQ(exported.cyclic[0].frames.size(), 2u);
+  const auto& f0 = exported.cyclic[0].frames[0].cmds;
+  const auto& f1 = exported.cyclic[0].frames[1].cmds;
+  ASSERT_EQ(f0.size(), 1u);
+  ASSERT_EQ(f1.size(), 2u);
+  EXPECT_EQ(f0[0].cmd, static_cast<std::uint8_t>(Command::kLwr));
+  EXPECT_EQ(f0[0].cnt, std::optional<std::uint16_t>(3));
+  EXPECT_EQ(f1[0].cmd, static_cast<std::uint8_t>(Command::kLrd));
+  EXPECT_EQ(f1[0].cnt, std::optional<std::uint16_t>(4));
+  EXPECT_EQ(f1[1].cmd, static_cast<std::uint8_t>(Command::kBrd));
+  EXPECT_EQ(f1[1].state, "OP");
+  EXPECT_FALSE(f1[1].addr.has_value());
+  EXPECT_EQ(f1[1].adp, std::optional<std::uint16_t>(0));
+  EXPECT_EQ(f1[1].ado, std::optional<std::uint16_t>(0x0130));
+  EXPECT_EQ(f1[1].cnt, std::optional<std::uint16_t>(6));
+}
+
 // ---- errors in the ENI: each names the file and the Cmd's line --------------------------------
 
 class EniCyclicErrorTest : public EniCyclicTest {
