@@ -319,7 +319,7 @@ MasterHealth HealthMonitor::health(const TransportCounters& transport) const {
   MasterHealth h;
   const CyclicStatistics& st = cyclic_.statistics();
   h.cycles = st.cycles;
-  h.framesLost = st.framesLost;
+  h.framesLost = transport.framesLost;
   h.framesLate = st.framesLate + transport.framesLate;
   h.wkcErrors = st.wkcErrors;
   h.cyclesWithErrors = st.cyclesWithErrors;

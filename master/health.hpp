@@ -71,8 +71,11 @@ struct SlaveHealth {
 
 struct MasterHealth {
   std::uint64_t cycles{0};
+  // Frames the network never returned (Transport: given up, no answer since). A cyclic frame
+  // answered after its cycle gave up on it is late, not lost; that cycle itself failed
+  // (CyclicStatistics::framesLost counts such frames per cycle).
   std::uint64_t framesLost{0};
-  std::uint64_t framesLate{0};  // cyclic frames answered after their deadline or abandoned
+  std::uint64_t framesLate{0};  // answered after their deadline, or after being given up
   std::uint64_t wkcErrors{0};
   std::uint64_t cyclesWithErrors{0};
   std::uint64_t slavesLost{0};  // events

@@ -71,13 +71,17 @@ struct RunResult {
   std::optional<master::LatencyHistogram> wakeLatency;  // --rt
 };
 
+// Lost: never returned by the network; late: returned after the deadline (MasterHealth), both
+// counted from `base`, the health when the cyclic run began (start-up frames are not its own).
 void printLive(const GlobalOptions& g, double second, const master::CyclicStatistics& st,
-               const master::MasterHealth& h, const std::vector<master::PdoVariable>& vars) {
+               const master::MasterHealth& h, const master::MasterHealth& base,
+               const std::vector<master::PdoVariable>& vars) {
   std::FILE* out = g.json ? stderr : stdout;
   fmt::print(out,
              "[{:6.1f} s] cycles {} rtt us {} | jitter p99 {:.1f} us | lost {} late {} wkc {}{}\n",
-             second, st.cycles, histogramText(st.roundTrip), us(st.jitter.p99()), h.framesLost,
-             h.framesLate, h.wkcErrors, variablesText(vars));
+             second, st.cycles, histogramText(st.roundTrip), us(st.jitter.p99()),
+             h.framesLost - base.framesLost, h.framesLate - base.framesLate, h.wkcErrors,
+             variablesText(vars));
   std::fflush(out);
 }
 
@@ -100,7 +104,7 @@ int runCyclic(const GlobalOptions& g, const CyclicOptions& o) {
   m.setCycleTime(cycle);
   m.resetStatistics();
   m.clearEvents();
-  const auto startCounters = m.transport().counters();
+  const master::MasterHealth base = m.health();
   SignalFlag stop;
   RunResult r;
   std::size_t eventsPrinted = 0;
@@ -130,7 +134,7 @@ int runCyclic(const GlobalOptions& g, const CyclicOptions& o) {
         const auto snap = driver.snapshot();
         printEvents(snap.events);
         printLive(g, static_cast<double>(clock.now() - start) / 1e9, snap.statistics, snap.health,
-                  vars);
+                  base, vars);
       }
     }
     driver.stop();
@@ -168,7 +172,7 @@ int runCyclic(const GlobalOptions& g, const CyclicOptions& o) {
       }
       if (bus.now() >= nextPrint && !o.quiet) {
         nextPrint += kNsPerSecond;
-        printLive(g, static_cast<double>(bus.now() - start) / 1e9, m.statistics(), m.health(),
+        printLive(g, static_cast<double>(bus.now() - start) / 1e9, m.statistics(), m.health(), base,
                   vars);
       }
       while (bus.now() < next && !stop.raised()) bus.wait(next);
@@ -179,9 +183,8 @@ int runCyclic(const GlobalOptions& g, const CyclicOptions& o) {
   }
   printEvents(r.events);
   const auto& st = r.statistics;
-  const auto& tc = m.transport().counters();
-  const std::uint64_t lost = tc.framesLost - startCounters.framesLost;
-  const std::uint64_t late = st.framesLate + (tc.framesLate - startCounters.framesLate);
+  const std::uint64_t lost = r.health.framesLost - base.framesLost;
+  const std::uint64_t late = r.health.framesLate - base.framesLate;
   (void)m.readStates();
   Status stopped = o.stopAtEnd ? m.stop() : okStatus();
   if (g.json) {
