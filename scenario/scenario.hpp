@@ -22,6 +22,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "protocol/result.hpp"
@@ -102,6 +103,13 @@ struct Scenario {
   std::vector<TimedAction> actions;
   std::vector<Expectation> expectations;
 };
+
+// What a <Detected condition="..."> may name: the runner's own observations of a cycle and the
+// master's events (master/health.hpp), "any-error" for everything but good news.
+inline constexpr std::string_view kDetectableConditions[] = {
+    "wkc-error",       "frame-lost",      "cycle-error",    "emergency",
+    "slave-state",     "slave-lost",      "slave-returned", "slave-reset",
+    "slave-recovered", "recovery-failed", "any-error"};
 
 Result<Scenario> loadScenario(const std::filesystem::path& path);
 Result<Scenario> parseScenario(std::string_view xml, const std::filesystem::path& path);

@@ -1,8 +1,10 @@
 // Reads scenario files (docs/scenarios.md) with tinyxml2; errors name file and line.
 #include <tinyxml2.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <regex>
 #include <sstream>
 
@@ -139,11 +141,13 @@ Result<Expectation> readExpectation(const Reader& r, const XMLElement* e) {
   } else if (tag == "Detected") {
     x.kind = ExpectKind::kDetected;
     x.condition = Reader::attr(e, "condition").value_or("");
-    if (x.condition != "wkc-error" && x.condition != "frame-lost" && x.condition != "slave-state" &&
-        x.condition != "slave-lost" && x.condition != "emergency" && x.condition != "any-error") {
-      return r.error(e,
-                     "condition must be wkc-error, frame-lost, slave-state, slave-lost, "
-                     "emergency or any-error");
+    if (std::find(std::begin(kDetectableConditions), std::end(kDetectableConditions),
+                  x.condition) == std::end(kDetectableConditions)) {
+      std::string names;
+      for (std::string_view c : kDetectableConditions) {
+        names += (names.empty() ? "" : ", ") + std::string(c);
+      }
+      return r.error(e, "condition must be one of " + names);
     }
     ECSIM_ASSIGN_OR_RETURN(auto after, r.number(e, "afterCycle"));
     ECSIM_ASSIGN_OR_RETURN(auto within, r.number(e, "withinCycles"));

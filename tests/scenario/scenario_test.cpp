@@ -57,6 +57,13 @@ TEST(ScenarioFile, ErrorsNameFileAndLine) {
                     "c.xml");
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().context.find("explode"), std::string::npos);
+  // The master's events are conditions too; an unknown one is named with the line.
+  s = parseScenario(wrap("<Expect>\n<Detected condition=\"slave-recovered\" withinCycles=\"5\"/>\n"
+                         "<Detected condition=\"slave-exploded\" withinCycles=\"5\"/></Expect>\n"),
+                    "d.xml");
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().context.find("d.xml, line 5"), std::string::npos) << s.error().context;
+  EXPECT_NE(s.error().context.find("recovery-failed"), std::string::npos) << s.error().context;
 }
 
 TEST(Runner, AFailingExpectationSaysWhatWhenAndWhat) {
