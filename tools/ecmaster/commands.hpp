@@ -39,7 +39,9 @@ CommandRunner addXmlCommand(CLI::App& app, const GlobalOptions& global);
 
 // Opens the connection and scans. `reset` resets the slaves to INIT and defaults first (a
 // start-up); without it the scan leaves their state alone (for looking at a running bus).
-Result<std::unique_ptr<Connection>> connectAndScan(const GlobalOptions& global, bool reset);
+// `recovery`: MasterOptions::recovery (cyclic health: lost slaves reported and brought back).
+Result<std::unique_ptr<Connection>> connectAndScan(const GlobalOptions& global, bool reset,
+                                                   bool recovery = true);
 // Prints "ecmaster: <message>" to stderr and returns 1.
 int fail(const Error& error);
 int fail(const std::string& message);

@@ -24,6 +24,7 @@ struct CyclicOptions {
   unsigned cycleUs{1000};
   double seconds{1.0};
   bool stopAtEnd{true};
+  bool recovery{true};
   bool rt{false};
   bool quiet{false};
   int cpu{-1};  // --cpu: pin to this CPU
@@ -86,7 +87,7 @@ void printLive(const GlobalOptions& g, double second, const master::CyclicStatis
 }
 
 int runCyclic(const GlobalOptions& g, const CyclicOptions& o) {
-  auto c = connectAndScan(g, true);
+  auto c = connectAndScan(g, true, o.recovery);
   if (!c.ok()) return fail(c.error());
   master::Master& m = (*c)->master();
   master::Bus& bus = (*c)->bus();
@@ -129,10 +130,10 @@ int runCyclic(const GlobalOptions& g, const CyclicOptions& o) {
     SimTime nextPrint = start + kNsPerSecond;
     while (!stop.raised() && clock.now() - start < duration) {
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      const auto snap = driver.snapshot();  // events as they come (the snapshot's period late)
+      printEvents(snap.events);
       if (clock.now() >= nextPrint && !o.quiet) {
         nextPrint += kNsPerSecond;
-        const auto snap = driver.snapshot();
-        printEvents(snap.events);
         printLive(g, static_cast<double>(clock.now() - start) / 1e9, snap.statistics, snap.health,
                   base, vars);
       }
@@ -254,6 +255,9 @@ CommandRunner addCyclicCommand(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--seconds", o->seconds, "How long to run (default 1)")
       ->check(CLI::Range(0.0, 86400.0));
   cmd->add_flag("!--no-stop", o->stopAtEnd, "Leave the slaves in OP at the end");
+  cmd->add_flag("!--no-recovery", o->recovery,
+                "Do not watch the slaves: no lost/returned events, nothing brought back to OP "
+                "(every missing working counter is an error)");
   cmd->add_option("--show", o->show,
                   "Print a process variable live and at the end (e.g. Drive1.Statusword); "
                   "repeatable");

@@ -26,9 +26,11 @@ void printJson(const nlohmann::json& value) {
   std::cout << value.dump(2) << "\n";
 }
 
-Result<std::unique_ptr<Connection>> connectAndScan(const GlobalOptions& global, bool reset) {
+Result<std::unique_ptr<Connection>> connectAndScan(const GlobalOptions& global, bool reset,
+                                                   bool recovery) {
   master::MasterOptions options;
   options.scan.resetToDefaults = reset;
+  options.recovery = recovery;
   options.transport.timeout = static_cast<SimTime>(global.timeoutMs) * kNsPerMs;
   ECSIM_ASSIGN_OR_RETURN(auto connection, Connection::open(global.connect, options));
   if (!global.config.empty()) ECSIM_TRY(connection->master().loadConfig(global.config));
