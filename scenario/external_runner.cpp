@@ -438,20 +438,12 @@ void ExternalRun::finish(SimTime end, const std::string& endText) {
 }
 
 ScenarioResult ExternalRun::execute() {
-  r_.name = s_.name;
-  r_.file = s_.file.filename().string();
-  r_.seed = o_.seed.value_or(s_.seed);
-  r_.cycleTime = s_.cycleTime;
+  r_ = startResult(s_, o_);
   if (s_.masterKind != "external") {
     r_.error = "not an external master (Master kind=\"" + s_.masterKind + "\")";
     return r_;
   }
-  auto config = loadTopologyFile(s_.topology);
-  if (!config.ok()) {
-    r_.error = config.error().message();
-    return r_;
-  }
-  auto network = topology::buildNetwork(*config);
+  auto network = buildScenarioNetwork(s_);
   if (!network.ok()) {
     r_.error = network.error().message();
     return r_;

@@ -372,20 +372,13 @@ void Run::evaluateWindows() {
 }
 
 ScenarioResult Run::execute() {
-  r_.name = s_.name;
-  r_.file = s_.file.filename().string();
-  r_.seed = o_.seed.value_or(s_.seed);
-  r_.cycleTime = s_.cycleTime;
+  r_ = startResult(s_, o_);
   if (s_.masterKind != "in-process") {
-    r_.error = "only the in-process master is implemented (Master kind=\"" + s_.masterKind + "\")";
+    r_.error = "not the in-process master (Master kind=\"" + s_.masterKind +
+               "\"): runAnyScenario (scenario/external_runner.hpp) runs each kind";
     return r_;
   }
-  auto config = loadTopologyFile(s_.topology);
-  if (!config.ok()) {
-    r_.error = config.error().message();
-    return r_;
-  }
-  auto network = topology::buildNetwork(*config);
+  auto network = buildScenarioNetwork(s_);
   if (!network.ok()) {
     r_.error = network.error().message();
     return r_;
@@ -541,6 +534,20 @@ bool ScenarioResult::passed() const {
 std::size_t ScenarioResult::failures() const {
   return static_cast<std::size_t>(
       std::count_if(results.begin(), results.end(), [](const auto& r) { return !r.passed; }));
+}
+
+ScenarioResult startResult(const Scenario& scenario, const RunOptions& options) {
+  ScenarioResult r;
+  r.name = scenario.name;
+  r.file = scenario.file.filename().string();
+  r.seed = options.seed.value_or(scenario.seed);
+  r.cycleTime = scenario.cycleTime;
+  return r;
+}
+
+Result<topology::Network> buildScenarioNetwork(const Scenario& scenario) {
+  ECSIM_ASSIGN_OR_RETURN(auto config, loadTopologyFile(scenario.topology));
+  return topology::buildNetwork(config);
 }
 
 ScenarioResult runScenario(const Scenario& scenario, const RunOptions& options) {

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "scenario/scenario.hpp"
+#include "topology/network_builder.hpp"
 
 namespace ecsim::scenario {
 
@@ -50,6 +51,11 @@ struct ScenarioResult {
 };
 
 ScenarioResult runScenario(const Scenario& scenario, const RunOptions& options = {});
+
+// What both runners (this one and scenario/external_runner.hpp) start from: the result's
+// heading (name, file, seed, cycle time) and the network of the scenario's topology file.
+ScenarioResult startResult(const Scenario& scenario, const RunOptions& options);
+Result<topology::Network> buildScenarioNetwork(const Scenario& scenario);
 
 // Human-readable report of one run (no wall-clock content: deterministic).
 std::string formatReport(const ScenarioResult& result);

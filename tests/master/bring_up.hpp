@@ -57,4 +57,19 @@ inline std::unique_ptr<slavesim::Slave> makeDemoSlave(std::uint32_t product,
   return nullptr;
 }
 
+// The demo network of examples/topologies/demo.xml in a line: Coupler, DI1, DO1, AI1, Drive1
+// and, with `drives` 2, Drive2. Then wired; the caller starts the network. `Net` has
+// segment() (SimNetwork and the tests' served or virtual networks).
+template <typename Net>
+void addDemoSlaves(Net& net, int drives = 2) {
+  net.segment().addSlave(makeDemoSlave(0x1100, "Coupler"));
+  net.segment().addSlave(makeDemoSlave(0x1008, "DI1"));
+  net.segment().addSlave(makeDemoSlave(0x2008, "DO1"));
+  net.segment().addSlave(makeDemoSlave(0x3102, "AI1"));
+  for (int d = 1; d <= drives; ++d) {
+    net.segment().addSlave(makeDemoSlave(0x7201, "Drive" + std::to_string(d)));
+  }
+  net.segment().wireLine();
+}
+
 }  // namespace ecsim::testing

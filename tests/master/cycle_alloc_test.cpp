@@ -134,12 +134,7 @@ constexpr int kCycles = 10000;
 class CycleAllocTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    net_.segment().addSlave(makeDemoSlave(0x1100, "Coupler"));
-    net_.segment().addSlave(makeDemoSlave(0x1008, "DI1"));
-    net_.segment().addSlave(makeDemoSlave(0x2008, "DO1"));
-    net_.segment().addSlave(makeDemoSlave(0x3102, "AI1"));
-    net_.segment().addSlave(makeDemoSlave(0x7201, "Drive1"));
-    net_.segment().wireLine();
+    addDemoSlaves(net_, 1);
     net_.start();
     master_ = std::make_unique<master::Master>(net_.masterLink(), bus_);
     auto status = master_->start();

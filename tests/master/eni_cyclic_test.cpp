@@ -80,13 +80,7 @@ class EniCyclicTest : public ::testing::Test {
  protected:
   EniCyclicTest() : capture_(net_.masterLink()) {}
   void SetUp() override {
-    net_.segment().addSlave(makeDemoSlave(0x1100, "Coupler"));
-    net_.segment().addSlave(makeDemoSlave(0x1008, "DI1"));
-    net_.segment().addSlave(makeDemoSlave(0x2008, "DO1"));
-    net_.segment().addSlave(makeDemoSlave(0x3102, "AI1"));
-    net_.segment().addSlave(makeDemoSlave(0x7201, "Drive1"));
-    net_.segment().addSlave(makeDemoSlave(0x7201, "Drive2"));
-    net_.segment().wireLine();
+    addDemoSlaves(net_);
     net_.start();
   }
 

@@ -130,12 +130,7 @@ class WatchedMailbox final : public slavesim::MailboxServer {
 class RecoveryTest : public ::testing::Test {
  protected:
   void build(bool recovery = true) {
-    net_.segment().addSlave(makeDemoSlave(0x1100, "Coupler"));
-    net_.segment().addSlave(makeDemoSlave(0x1008, "DI1"));
-    net_.segment().addSlave(makeDemoSlave(0x2008, "DO1"));
-    net_.segment().addSlave(makeDemoSlave(0x3102, "AI1"));
-    net_.segment().addSlave(makeDemoSlave(0x7201, "Drive1"));
-    net_.segment().wireLine();
+    addDemoSlaves(net_, 1);
     net_.start();
     master::MasterOptions options;
     options.recovery = recovery;
@@ -404,13 +399,7 @@ TEST_F(RecoveryFailureTest, EepromChecksumErrorIsReportedOnceAndTheOthersKeepRun
 // 0x8000:01 (the filter of channel 1).
 TEST(EniRecoveryTest, PowerCycledSlaveGetsItsEniInitCommandsAgain) {
   SimNetwork net;
-  net.segment().addSlave(makeDemoSlave(0x1100, "Coupler"));
-  net.segment().addSlave(makeDemoSlave(0x1008, "DI1"));
-  net.segment().addSlave(makeDemoSlave(0x2008, "DO1"));
-  net.segment().addSlave(makeDemoSlave(0x3102, "AI1"));
-  net.segment().addSlave(makeDemoSlave(0x7201, "Drive1"));
-  net.segment().addSlave(makeDemoSlave(0x7201, "Drive2"));
-  net.segment().wireLine();
+  addDemoSlaves(net);
   net.start();
   std::ifstream in(std::string(ECSIM_SOURCE_DIR) + "/examples/eni/demo-eni.xml");
   std::string xml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -67,13 +67,7 @@ enum : std::size_t { kCoupler, kDi, kDo, kAi, kDrive, kDrive2, kCount };
 class DemoVariablesTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    net_.segment().addSlave(makeDemoSlave(0x1100, "Coupler"));
-    net_.segment().addSlave(makeDemoSlave(0x1008, "DI1"));
-    net_.segment().addSlave(makeDemoSlave(0x2008, "DO1"));
-    net_.segment().addSlave(makeDemoSlave(0x3102, "AI1"));
-    net_.segment().addSlave(makeDemoSlave(0x7201, "Drive1"));
-    net_.segment().addSlave(makeDemoSlave(0x7201, "Drive2"));
-    net_.segment().wireLine();
+    addDemoSlaves(net_);
     net_.start();
     master_ = std::make_unique<master::Master>(net_.masterLink(), net_.bus());
   }
