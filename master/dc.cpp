@@ -74,6 +74,38 @@ std::vector<SimTime> computeDcDelays(const std::vector<SlaveInfo>& slaves,
   return delay;
 }
 
+std::optional<DcRecovery> dcRecoveryFor(const DcSetup& setup, const std::vector<SlaveInfo>& slaves,
+                                        std::size_t position, SimTime sync0Margin) {
+  if (!setup.reference || *setup.reference >= slaves.size() || position == *setup.reference ||
+      position >= setup.dc.size() || !setup.dc[position] || position >= setup.delays.size()) {
+    return std::nullopt;
+  }
+  DcRecovery r;
+  r.referenceStation = slaves[*setup.reference].station;
+  r.delay = setup.delays[position];
+  r.sync0Margin = sync0Margin;
+  if (std::find(setup.sync0.begin(), setup.sync0.end(), position) != setup.sync0.end() &&
+      position < setup.assignActivate.size() && setup.sync0Cycle > 0) {
+    r.sync0 = true;
+    r.assignActivate = setup.assignActivate[position];
+    r.sync0Start = setup.sync0Start;
+    r.sync0Cycle = setup.sync0Cycle;
+  }
+  return r;
+}
+
+std::uint64_t recoveredDcOffset(std::uint64_t referenceLocal, std::uint64_t referenceOffset,
+                                std::uint64_t slaveLocal, SimTime delay) {
+  return referenceLocal + referenceOffset + static_cast<std::uint64_t>(delay) - slaveLocal;
+}
+
+std::uint64_t nextSync0Time(std::uint64_t gridStart, SimTime cycle, std::uint64_t earliest) {
+  if (cycle <= 0 || static_cast<std::int64_t>(earliest - gridStart) <= 0) return gridStart;
+  const auto c = static_cast<std::uint64_t>(cycle);
+  const std::uint64_t since = earliest - gridStart;
+  return gridStart + (since + c - 1) / c * c;
+}
+
 DcInitTask::DcInitTask(Transport& transport, std::vector<SlaveInfo>& slaves, DcOptions options,
                        SimTime cycleTime, std::vector<std::uint16_t> assignActivate)
     : transport_(transport),
@@ -92,6 +124,7 @@ void DcInitTask::start(SimTime now) {
   status_ = okStatus();
   setup_ = {};
   setup_.dc.assign(slaves_.size(), false);
+  setup_.assignActivate.assign(slaves_.size(), 0);
   for (const auto& s : slaves_) {
     setup_.dc[s.position] = s.hasDc();
     if (s.hasDc() && !setup_.reference) setup_.reference = s.position;
@@ -207,6 +240,7 @@ bool DcInitTask::step(SimTime now) {
       for (std::size_t i = 0; i < slaves_.size() && i < assignActivate_.size(); ++i) {
         if (options_.activateSync0 && setup_.dc[i] && assignActivate_[i] != 0) {
           setup_.sync0.push_back(i);
+          setup_.assignActivate[i] = assignActivate_[i];
         }
       }
       if (setup_.sync0.empty() || cycleTime_ <= 0) {

@@ -39,6 +39,9 @@ struct DcOptions {
   SimTime sync0Cycle{0};  // 0: MasterOptions::cycleTime
   SimTime sync0Shift{0};
   SimTime sync0StartDelay{100 * kNsPerMs};
+  // A recovered slave's SYNC0 starts on the running grid at least this long after the
+  // reference's system time when the recovery reads it (DcRecovery::sync0Margin).
+  SimTime recoverySync0Margin{10 * kNsPerMs};
   // The master's time written as every slave's system time at the latch (ns since 2000);
   // nullopt: the bus clock's time at the latch.
   std::optional<std::uint64_t> masterTime;
@@ -59,12 +62,13 @@ std::vector<SimTime> computeDcDelays(const std::vector<SlaveInfo>& slaves,
                                      const std::vector<PortTimes>& times);
 
 struct DcSetup {
-  std::optional<std::size_t> reference;  // position of the reference clock
-  std::vector<bool> dc;                  // per slave: has a DC unit (0x0008 bit 2)
-  std::vector<SimTime> delays;           // per slave, relative to the reference (0x0928)
-  std::vector<std::uint64_t> offsets;    // per slave (0x0920)
-  std::vector<std::size_t> sync0;        // positions SYNC0 was activated for
-  std::uint64_t sync0Start{0};           // 0x0990 written
+  std::optional<std::size_t> reference;       // position of the reference clock
+  std::vector<bool> dc;                       // per slave: has a DC unit (0x0008 bit 2)
+  std::vector<SimTime> delays;                // per slave, relative to the reference (0x0928)
+  std::vector<std::uint64_t> offsets;         // per slave (0x0920)
+  std::vector<std::size_t> sync0;             // positions SYNC0 was activated for
+  std::vector<std::uint16_t> assignActivate;  // per slave: the 0x0980 word written (0: none)
+  std::uint64_t sync0Start{0};                // 0x0990 written
   SimTime sync0Cycle{0};
 };
 
@@ -97,6 +101,42 @@ class DcInitTask final : public Task {
   std::uint64_t masterTime_{0};
   Status status_;
 };
+
+// What a recovery needs to give a power-cycled DC slave its clock back (SlaveRecoveryTask's
+// stage kDc, in PREOP before PREOP->SAFEOP):
+//   1. BWR 0x0900: every ESC latches its local time at that datagram in 0x0918, the reference
+//      and this slave at the same point of the same frame, as the start-up's latch does;
+//   2. FPRD the reference's 0x0918-0x0927 (latched local time and its offset: its system time
+//      at the latch) and the slave's 0x0918;
+//   3. FPWR 0x0928 = delay, 0x0920 = recoveredDcOffset(), 0x0930 = 0x1000 (restart the drift
+//      filter, as start-up does); with SYNC0: 0x0981 = 0, 0x09A0 = cycle, 0x0990 =
+//      nextSync0Time(grid, reference's system time at the latch + margin), 0x0980/0x0981 =
+//      assignActivate.
+struct DcRecovery {
+  std::uint16_t referenceStation{0};
+  SimTime delay{0};  // 0x0928, from DcSetup::delays
+  bool sync0{false};
+  std::uint16_t assignActivate{0};  // 0x0980 word
+  std::uint64_t sync0Start{0};      // the grid the others run on: sync0Start + k * sync0Cycle
+  SimTime sync0Cycle{0};
+  SimTime sync0Margin{10 * kNsPerMs};
+};
+
+// The recovery's data for the slave at `position`; nullopt when the master did not set it up
+// for distributed clocks (no DC set-up, no DC unit, or the reference clock itself).
+std::optional<DcRecovery> dcRecoveryFor(const DcSetup& setup, const std::vector<SlaveInfo>& slaves,
+                                        std::size_t position, SimTime sync0Margin);
+
+// 0x0920 for a slave whose local time was `slaveLocal` when one datagram passed it, the
+// reference's local time being `referenceLocal` (offset `referenceOffset`) when the same datagram
+// passed the reference `delay` earlier: its system time then equals the reference's at once,
+// modulo 2^64 (the start-up's offsets leave a lag of the delay for the drift loop to take up).
+std::uint64_t recoveredDcOffset(std::uint64_t referenceLocal, std::uint64_t referenceOffset,
+                                std::uint64_t slaveLocal, SimTime delay);
+
+// The first point of the grid gridStart + k * cycle (k >= 0) at or after `earliest`; gridStart
+// itself when cycle is 0 or earliest is not after it.
+std::uint64_t nextSync0Time(std::uint64_t gridStart, SimTime cycle, std::uint64_t earliest);
 
 // The largest |system time difference| (0x092C, sign-magnitude) over the DC slaves other than
 // the reference, as a batch to queue and a function to read it once answered.

@@ -15,7 +15,7 @@ SlaveRecoveryTask::Stage firstStage(const SlaveInfo& slave) {
     case AlState::kBootstrap:
       return SlaveRecoveryTask::Stage::kIdentity;
     case AlState::kPreOp:
-      return SlaveRecoveryTask::Stage::kProcess;
+      return SlaveRecoveryTask::Stage::kDc;  // nothing there for a slave without DC set-up
     case AlState::kSafeOp:
     case AlState::kOp:
       break;

@@ -236,7 +236,9 @@ Status Master::configureProcessData() {
   cyclic_.setTiming(options_.cycleTime, options_.cycleTime);
   health_ = std::make_unique<HealthMonitor>(
       transport_, slaves_, layout_, cyclic_, options_.recovery, options_.health, options_.state,
-      std::make_unique<MasterSlaveSetup>(processData_, config_), options_.mailbox);
+      std::make_unique<MasterSlaveSetup>(processData_, config_, &dc_, &slaves_,
+                                         options_.dc.recoverySync0Margin),
+      options_.mailbox);
   std::vector<std::string> names;  // the configuration's names, else the SII's
   if (config_) {
     for (const auto& expected : config_->slaves) names.push_back(expected.name);

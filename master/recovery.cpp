@@ -13,6 +13,19 @@ constexpr std::uint16_t kEepromReadLength = static_cast<std::uint16_t>(
 constexpr std::size_t kEepromDataOffset = reg::kSiiData.address - reg::kSiiControlStatus.address;
 constexpr std::size_t kIdentityBytes = 8;             // vendor id, product code
 constexpr std::uint16_t kPdoAssignmentBase = 0x1C10;  // + SM number
+// The reference's latched local time 0x0918 and its offset 0x0920 in one read.
+constexpr std::uint16_t kDcLatchAndOffsetLength = static_cast<std::uint16_t>(
+    reg::kSystemTimeOffset.end() - reg::kReceiveTimeEcatProcessingUnit.address);
+constexpr std::uint16_t kSpeedCounterRestart = 0x1000;  // 0x0930, as the DC set-up writes it
+
+template <typename T>
+std::vector<std::uint8_t> le(T value) {
+  std::vector<std::uint8_t> out(sizeof(T));
+  for (std::size_t i = 0; i < sizeof(T); ++i) {
+    out[i] = static_cast<std::uint8_t>(static_cast<std::uint64_t>(value) >> (8 * i));
+  }
+  return out;
+}
 
 std::string hex(unsigned v, int digits) {
   static constexpr char kDigits[] = "0123456789ABCDEF";
@@ -128,6 +141,11 @@ std::vector<SetupWrite> MasterSlaveSetup::writesFor(const SlaveInfo& slave, AlSt
   return out;
 }
 
+std::optional<DcRecovery> MasterSlaveSetup::dcRecovery(const SlaveInfo& slave) const {
+  if (dc_ == nullptr || slaves_ == nullptr) return std::nullopt;
+  return dcRecoveryFor(*dc_, *slaves_, slave.position, sync0Margin_);
+}
+
 std::string_view toString(SlaveRecoveryTask::Stage stage) {
   switch (stage) {
     case SlaveRecoveryTask::Stage::kAddress:
@@ -136,6 +154,8 @@ std::string_view toString(SlaveRecoveryTask::Stage stage) {
       return "identity";
     case SlaveRecoveryTask::Stage::kMailbox:
       return "mailbox and PREOP";
+    case SlaveRecoveryTask::Stage::kDc:
+      return "distributed clock";
     case SlaveRecoveryTask::Stage::kProcess:
       return "process data and SAFEOP";
     case SlaveRecoveryTask::Stage::kOp:
@@ -206,6 +226,20 @@ void SlaveRecoveryTask::enter(Stage stage, SimTime now) {
     case Stage::kMailbox:
       addMailboxSetup(batch_, slave_);
       break;
+    case Stage::kDc:
+      dc_ = setup_ != nullptr ? setup_->dcRecovery(slave_) : std::nullopt;
+      if (!dc_) {
+        enter(Stage::kProcess, now);
+        return;
+      }
+      // One datagram latches the reference's and this slave's local time (0x0918) at the
+      // same point of the frame; the count of slaves is not checked.
+      batch_.add().prepare(Command::kBwr,
+                           DatagramHeader::physical(0, reg::kReceiveTimePort0.address),
+                           std::uint16_t{4}, 0);
+      batch_.queueAll(transport_);
+      sub_ = Sub::kDcLatch;
+      return;
     case Stage::kProcess:
       startWrites(AlState::kSafeOp);  // then the SMs and FMMUs (queueProcessDataSetup)
       return;
@@ -366,6 +400,61 @@ bool SlaveRecoveryTask::stepStateChange(AlState target, Stage next, SimTime now)
   return true;
 }
 
+bool SlaveRecoveryTask::stepDc(SimTime now) {
+  if (batch_.pending()) return true;
+  const DcRecovery& dc = *dc_;
+  if (sub_ == Sub::kDcLatch) {
+    if (!batch_[0].received()) {
+      fail(makeError(ErrorCode::kTimeout, "time latch: " + batch_[0].describe()));
+      return false;
+    }
+    batch_.clear();
+    batch_.add().fprd(dc.referenceStation, reg::kReceiveTimeEcatProcessingUnit.address,
+                      kDcLatchAndOffsetLength);
+    batch_.add().fprd(slave_.station, reg::kReceiveTimeEcatProcessingUnit.address,
+                      reg::kReceiveTimeEcatProcessingUnit.width);
+    batch_.queueAll(transport_);
+    sub_ = Sub::kDcRead;
+    return true;
+  }
+  if (auto s = batch_.check(); !s.ok()) {
+    fail(makeError(s.error().code, (sub_ == Sub::kDcRead ? "latched times (reference clock " +
+                                                               hex(dc.referenceStation, 4) + "): "
+                                                         : std::string("DC registers: ")) +
+                                       s.error().context));
+    return false;
+  }
+  if (sub_ == Sub::kDcWrite) {
+    enter(Stage::kProcess, now);
+    return true;
+  }
+  // kDcRead answered: the reference's system time at the latch, and this slave's local time.
+  const std::uint64_t referenceLocal = readLe64(batch_[0].data(), 0);
+  const std::uint64_t referenceOffset =
+      readLe64(batch_[0].data(),
+               reg::kSystemTimeOffset.address - reg::kReceiveTimeEcatProcessingUnit.address);
+  const std::uint64_t slaveLocal = readLe64(batch_[1].data(), 0);
+  const std::uint64_t referenceTime = referenceLocal + referenceOffset;
+  batch_.clear();
+  batch_.add().fpwr(slave_.station, reg::kSystemTimeDelay.address,
+                    le(static_cast<std::uint32_t>(dc.delay)));
+  batch_.add().fpwr(slave_.station, reg::kSystemTimeOffset.address,
+                    le(recoveredDcOffset(referenceLocal, referenceOffset, slaveLocal, dc.delay)));
+  batch_.add().fpwr(slave_.station, reg::kSpeedCounterStart.address, le(kSpeedCounterRestart));
+  if (dc.sync0) {
+    const std::uint64_t start = nextSync0Time(
+        dc.sync0Start, dc.sync0Cycle, referenceTime + static_cast<std::uint64_t>(dc.sync0Margin));
+    batch_.add().fpwr(slave_.station, reg::kDcActivation.address, le(std::uint8_t{0}));
+    batch_.add().fpwr(slave_.station, reg::kSync0CycleTime.address,
+                      le(static_cast<std::uint32_t>(dc.sync0Cycle)));
+    batch_.add().fpwr(slave_.station, reg::kStartTimeCyclicOperation.address, le(start));
+    batch_.add().fpwr(slave_.station, reg::kCyclicUnitControl.address, le(dc.assignActivate));
+  }
+  batch_.queueAll(transport_);
+  sub_ = Sub::kDcWrite;
+  return true;
+}
+
 bool SlaveRecoveryTask::step(SimTime now) {
   if (done()) return false;
   if (now > deadline_) {
@@ -383,6 +472,8 @@ bool SlaveRecoveryTask::step(SimTime now) {
       return true;
     case Stage::kIdentity:
       return stepIdentity(now);
+    case Stage::kDc:
+      return stepDc(now);
     case Stage::kMailbox:  // SMs, writes, PREOP
     case Stage::kProcess:  // writes, SMs and FMMUs, SAFEOP
       if (sub_ == Sub::kWait) {
@@ -406,7 +497,7 @@ bool SlaveRecoveryTask::step(SimTime now) {
         }
         sub_ = Sub::kStart;
       }
-      return stage_ == Stage::kMailbox ? stepStateChange(AlState::kPreOp, Stage::kProcess, now)
+      return stage_ == Stage::kMailbox ? stepStateChange(AlState::kPreOp, Stage::kDc, now)
                                        : stepStateChange(AlState::kSafeOp, Stage::kOp, now);
     case Stage::kOp:
       if (sub_ == Sub::kWrites) {

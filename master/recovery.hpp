@@ -10,6 +10,11 @@
 //              and the slave cannot leave INIT) fails the task saying so
 //   kMailbox   mailbox SyncManagers as at start-up, the setup's register writes for PREOP,
 //              then INIT -> PREOP
+//   kDc        for a slave the master set up for distributed clocks (SlaveSetup::dcRecovery):
+//              its delay 0x0928, a new offset 0x0920 from one latch of the reference's and its
+//              local time, the drift filter restarted, and SYNC0 on the running grid (see
+//              DcRecovery in master/dc.hpp); nothing for the others. A drive in DC-synchronous
+//              mode would refuse SAFEOP (0x0030) or run unsynchronised without it
 //   kProcess   the setup's writes for SAFEOP (CoE downloads: the PDO assignment the master
 //              found or configured, an ENI's init commands), the SM and FMMU settings of the
 //              slave's part of the process image, then PREOP -> SAFEOP
@@ -30,6 +35,7 @@
 #include "master/batch.hpp"
 #include "master/bus.hpp"
 #include "master/coe_client.hpp"
+#include "master/dc.hpp"
 #include "master/eni_config.hpp"
 #include "master/pdo_config.hpp"
 #include "master/process_image.hpp"
@@ -59,6 +65,11 @@ class SlaveSetup {
  public:
   virtual ~SlaveSetup() = default;
   virtual std::vector<SetupWrite> writesFor(const SlaveInfo& slave, AlState target) const = 0;
+  // Its distributed clock, for a slave the master set up for DC (nullopt: none).
+  virtual std::optional<DcRecovery> dcRecovery(const SlaveInfo& slave) const {
+    (void)slave;
+    return std::nullopt;
+  }
 };
 
 // The CoE downloads that give a slave the PDO assignment `data` describes (0x1C10+SM: sub 0
@@ -68,22 +79,42 @@ std::vector<SetupWrite> pdoAssignmentWrites(const SlaveProcessData& data);
 // The master's own SlaveSetup: for a slave configured from an ENI, its init commands (register
 // writes, CoE downloads) of INIT->PREOP and PREOP->SAFEOP (and SAFEOP->OP), the CoE ones of
 // INIT->PREOP once PREOP is reached, as Master::requestState() runs them; otherwise the PDO
-// assignment the master found through CoE. Both references must outlive it.
+// assignment the master found through CoE. With `dc` (and `slaves`, the bus it was made for),
+// the DC set-up of the slaves it covers. All references and pointers must outlive it.
 class MasterSlaveSetup final : public SlaveSetup {
  public:
   MasterSlaveSetup(const std::vector<SlaveProcessData>& processData,
-                   const std::optional<MasterConfig>& config)
-      : processData_(processData), config_(config) {}
+                   const std::optional<MasterConfig>& config, const DcSetup* dc = nullptr,
+                   const std::vector<SlaveInfo>* slaves = nullptr,
+                   SimTime sync0Margin = 10 * kNsPerMs)
+      : processData_(processData),
+        config_(config),
+        dc_(dc),
+        slaves_(slaves),
+        sync0Margin_(sync0Margin) {}
   std::vector<SetupWrite> writesFor(const SlaveInfo& slave, AlState target) const override;
+  std::optional<DcRecovery> dcRecovery(const SlaveInfo& slave) const override;
 
  private:
   const std::vector<SlaveProcessData>& processData_;
   const std::optional<MasterConfig>& config_;
+  const DcSetup* dc_;
+  const std::vector<SlaveInfo>* slaves_;
+  SimTime sync0Margin_;
 };
 
 class SlaveRecoveryTask final : public Task {
  public:
-  enum class Stage : std::uint8_t { kAddress, kIdentity, kMailbox, kProcess, kOp, kDone, kFailed };
+  enum class Stage : std::uint8_t {
+    kAddress,
+    kIdentity,
+    kMailbox,
+    kDc,
+    kProcess,
+    kOp,
+    kDone,
+    kFailed
+  };
 
   // `slave` is the master's record (updated as the task learns the AL status); `layout` the
   // process image whose SM/FMMU settings the slave gets back. Both must outlive the task.
@@ -101,7 +132,16 @@ class SlaveRecoveryTask final : public Task {
   const Status& status() const { return status_; }
 
  private:
-  enum class Sub : std::uint8_t { kStart, kWait, kWrites, kEepromCommand, kEepromPoll };
+  enum class Sub : std::uint8_t {
+    kStart,
+    kWait,
+    kWrites,
+    kEepromCommand,
+    kEepromPoll,
+    kDcLatch,
+    kDcRead,
+    kDcWrite
+  };
 
   void enter(Stage stage, SimTime now);
   void fail(Status status);
@@ -111,6 +151,7 @@ class SlaveRecoveryTask final : public Task {
   void startWrites(AlState target);
   bool stepWrites(SimTime now);
   void queueProcessDataSetup();
+  bool stepDc(SimTime now);
 
   Transport& transport_;
   SlaveInfo& slave_;
@@ -131,6 +172,7 @@ class SlaveRecoveryTask final : public Task {
   std::size_t write_{0};
   bool writeQueued_{false};
   std::unique_ptr<SdoTask> sdo_;
+  std::optional<DcRecovery> dc_;
 };
 
 std::string_view toString(SlaveRecoveryTask::Stage stage);
