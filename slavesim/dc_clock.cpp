@@ -25,6 +25,12 @@ void DcClock::configure(SimTime offset, double driftPpm) {
   resetControl();
 }
 
+void DcClock::restart(SimTime global) {
+  tBase_ = global;
+  localBase_ = 0;
+  resetControl();
+}
+
 void DcClock::resetControl() {
   correctionPpb_ = 0.0;
   integralPpb_ = 0.0;

@@ -31,6 +31,9 @@ class DcClock {
                                  unsigned filterDepth);
   // 0x0930 write: resets the control loop (speed counter start).
   void resetControl();
+  // Power-up at global time `global`: the local time starts again from 0 (the oscillator's
+  // drift stays what it is), the control loop from scratch.
+  void restart(SimTime global);
 
   double ratePpm() const { return (driftPpb_ + correctionPpb_) * 1e-3; }
   double correctionPpm() const { return correctionPpb_ * 1e-3; }

@@ -9,8 +9,9 @@ Slave::Slave(std::string name, const EscType& type, std::vector<std::uint8_t> si
       profile_(std::move(profile)),
       mailboxBuffer_(static_cast<std::size_t>(type.ramKb) * 1024) {}
 
-void Slave::powerOn() {
+void Slave::powerOn(SimTime now) {
   esc_.powerOnReset();
+  esc_.dcClock().restart(now);
   esm_ = AlStateMachine{};  // the firmware's own state starts over too
   powered_ = true;
   firmwareRunning_ = (esc_.reg16(reg::kDlStatus.address) & reg::dl_status::kPdiOperational) != 0;

@@ -78,7 +78,9 @@ class Slave {
   // (PDI operational), so a slave with an EEPROM checksum error stays in INIT. A cold start
   // that fails (a device model that cannot be re-created) is kept in coldStartStatus().
   void powerOff() { powered_ = false; }
-  void powerOn();
+  // Power-up at simulation time `now`: registers reset, the ESC's local clock from 0, the
+  // firmware's state machine and the device cold-started (Device::coldStart).
+  void powerOn(SimTime now);
   bool powered() const { return powered_; }
   bool firmwareRunning() const { return powered_ && firmwareRunning_; }
   const Status& coldStartStatus() const { return coldStartStatus_; }

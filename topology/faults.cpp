@@ -325,11 +325,11 @@ Result<std::string> FaultInjector::powerOff(std::size_t s) {
   return slave.name() + " powered off";
 }
 
-Result<std::string> FaultInjector::powerOn(std::size_t s) {
+Result<std::string> FaultInjector::powerOn(std::size_t s, SimTime now) {
   auto& slave = segment_.slave(s);
   // Slave::powerOn also cold-starts the device: dictionary values back to power-up, the model
   // re-created (a drive keeps its shaft angle and state file).
-  slave.powerOn();
+  slave.powerOn(now);
   poweredOff_.erase(s);
   if (!slave.coldStartStatus().ok()) {
     return makeError(ErrorCode::kState,
@@ -429,10 +429,10 @@ Result<std::string> FaultInjector::apply(const FaultAction& a, SimTime now) {
   const std::size_t s = *index;
   auto& slave = segment_.slave(s);
   if (v == "power-off") return powerOff(s);
-  if (v == "power-on") return powerOn(s);
+  if (v == "power-on") return powerOn(s, now);
   if (v == "power-cycle") {
     if (auto off = powerOff(s); !off.ok()) return off.takeError();
-    return powerOn(s);
+    return powerOn(s, now);
   }
   if (v == "al-error") {
     ECSIM_ASSIGN_OR_RETURN(auto code, a.number("code"));
@@ -452,7 +452,7 @@ Result<std::string> FaultInjector::apply(const FaultAction& a, SimTime now) {
     esc.writeSiiByte(kSiiChecksumByte,
                      static_cast<std::uint8_t>(esc.sii()[kSiiChecksumByte] ^ 0x5A));
     if (auto off = powerOff(s); !off.ok()) return off.takeError();
-    return powerOn(s);
+    return powerOn(s, now);
   }
   if (v == "mailbox-silent" || v == "mailbox-ok") {
     if (slave.mailboxServer() == nullptr) return a.error(slave.name() + " has no mailbox");

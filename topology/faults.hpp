@@ -114,7 +114,7 @@ class FaultInjector final : public WireFaults {
   std::optional<End> peer(End end) const;
   void setCable(End end, bool up);
   Result<std::string> powerOff(std::size_t s);
-  Result<std::string> powerOn(std::size_t s);
+  Result<std::string> powerOn(std::size_t s, SimTime now);
 
   Network& network_;
   Segment& segment_;

@@ -149,7 +149,7 @@ TEST_F(DcRecoveryTest, PowerCycledDriveGetsItsClockAndSync0BackOnTheRunningGrid)
 
   auto& drive2 = net_.segment().slave(kDrive2);
   drive2.powerOff();
-  drive2.powerOn();
+  drive2.powerOn(net_.clock().now());
   ASSERT_EQ(esc(kDrive2).reg8(0x0981), 0x00) << "the power cycle stopped SYNC0";
   ASSERT_EQ(esc(kDrive2).reg32(0x0928), 0u);
 

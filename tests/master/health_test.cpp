@@ -298,7 +298,7 @@ class RecoveryFailureTest : public RecoveryTest {
   }
   void powerCycle(std::size_t i) {
     sim(i).powerOff();
-    sim(i).powerOn();
+    sim(i).powerOn(net_.clock().now());
   }
   std::size_t countEvents(MasterEventKind kind, std::size_t position) const {
     return static_cast<std::size_t>(
@@ -421,7 +421,7 @@ TEST(EniRecoveryTest, PowerCycledSlaveGetsItsEniInitCommandsAgain) {
   WatchedMailbox& mailbox = *watched;
   aiSim.setMailboxServer(std::move(watched));
   aiSim.powerOff();
-  aiSim.powerOn();
+  aiSim.powerOn(net.clock().now());
   ASSERT_EQ(aiSim.esc().reg16(kWatchdogTime), 1000);
   bool back = false;
   for (int i = 0; i < 3000 && !back; ++i) {

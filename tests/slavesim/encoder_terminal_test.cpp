@@ -142,7 +142,7 @@ TEST(EncoderTerminal, PowerCycleKeepsMultiTurnPositionFaultAndScript) {
   ASSERT_EQ(n.counter(), asCounter(5.75 * kCpr));
   n.terminal()->setFault(1, ef::kPower);
   slave.powerOff();
-  slave.powerOn();
+  slave.powerOn(n.x.now);
   ASSERT_TRUE(slave.coldStartStatus().ok()) << slave.coldStartStatus().error().message();
   ASSERT_NE(n.terminal(), nullptr);
   EXPECT_EQ(slave.state(), AlState::kInit);
@@ -154,7 +154,7 @@ TEST(EncoderTerminal, PowerCycleKeepsMultiTurnPositionFaultAndScript) {
 
   n.terminal()->setScript(1, dev::Signal::constant(angleFor(-1.5 * kCpr) / kTurn));  // turns
   slave.powerOff();
-  slave.powerOn();
+  slave.powerOn(n.x.now);
   n.x.now += kNsPerMs;
   n.toOp();
   EXPECT_EQ(n.counter(), asCounter(-1.5 * kCpr)) << "the script drives the new terminal";
@@ -171,7 +171,7 @@ TEST(EncoderTerminal, IncrementalEncoderCountsFromZeroAfterAPowerCycle) {
   n.x.cycle();
   EXPECT_EQ(n.counter(), 65536u);
   n.seg.slave(0).powerOff();
-  n.seg.slave(0).powerOn();
+  n.seg.slave(0).powerOn(n.x.now);
   n.x.now += kNsPerMs;
   n.toOp();
   EXPECT_EQ(n.counter(), 0u) << "an incremental encoder's zero is where it was switched on";

@@ -211,6 +211,23 @@ TEST_F(TimeUnits, PulsesAreInSystemTimeOfTheDriftingClock) {
   EXPECT_EQ(pulses_.size(), 11u) << "local 10..20.002 ms";
 }
 
+// A power cycle restarts the ESC's local clock from 0 (datasheet: the local time register
+// 0x0910 counts from power-up); the oscillator's drift is the same afterwards.
+TEST_F(TimeUnits, PowerCycleRestartsTheLocalClockFromZero) {
+  make();
+  seg_.setClock(0, 0, 100.0);  // 100 ppm fast
+  // The read samples the clock when the datagram passes the slave, a little after the frame's
+  // start: the same lag for both reads.
+  const auto before = static_cast<double>(readLe64(rd(0x0910, 8, 20 * kMs), 0));
+  const double lag = before - 20'002'000.0;
+  EXPECT_GT(lag, 0.0);
+  EXPECT_LT(lag, 10'000.0);
+  seg_.slave(0).powerOff();
+  seg_.slave(0).powerOn(30 * kMs);
+  one(seg_, Command::kApwr, phys(0, 0x0010), le16(kStation), 30 * kMs);  // address cleared too
+  EXPECT_NEAR(static_cast<double>(readLe64(rd(0x0910, 8, 35 * kMs), 0)), 5'000'500.0 + lag, 2.0);
+}
+
 TEST_F(TimeUnits, StartTimeInThePastNeverPulses) {
   make();
   idle(50 * kMs);
