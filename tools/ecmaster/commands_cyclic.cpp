@@ -109,9 +109,13 @@ int runCyclic(const GlobalOptions& g, const CyclicOptions& o) {
   SignalFlag stop;
   RunResult r;
   std::size_t eventsPrinted = 0;
+  // Each event leaves at once, also into a pipe or file (a log watcher, a scenario judging
+  // when the line appeared).
   auto printEvents = [&](const std::vector<master::MasterEvent>& events) {
+    std::FILE* out = g.json ? stderr : stdout;
     for (; eventsPrinted < events.size(); ++eventsPrinted) {
-      fmt::print(g.json ? stderr : stdout, "event: {}\n", events[eventsPrinted].text);
+      fmt::print(out, "event: {}\n", events[eventsPrinted].text);
+      std::fflush(out);
     }
   };
   std::vector<std::string> warnings;
