@@ -265,6 +265,34 @@ Result<CommandOutput> runCommand(const std::vector<std::string>& argv) {
   return result;
 }
 
+namespace {
+
+// `ip link set up` returns before the kernel's link watcher has seen the carrier: until then the
+// interface's queueing discipline is "noop" and every frame sent is dropped without an error
+// (a test's first frame vanished this way on a busy CI machine). Wait until the interface is
+// operationally up and has its real queueing discipline.
+Status waitOperational(const std::string& netns, const std::string& interface) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  std::string last;
+  for (;;) {
+    auto out = runCommand({"ip", "-n", netns, "-o", "link", "show", interface});
+    if (out.ok() && out->exitCode == 0) {
+      last = out->output;
+      if (last.find("state UP") != std::string::npos &&
+          last.find("qdisc noop") == std::string::npos) {
+        return okStatus();
+      }
+    }
+    if (std::chrono::steady_clock::now() >= deadline) {
+      return makeError(ErrorCode::kTimeout, "veth end " + interface + " in network namespace " +
+                                                netns + " not operational after 5 s: " + last);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+}
+
+}  // namespace
+
 Result<VethNamespace> VethNamespace::create(const VethOptions& options) {
   ECSIM_TRY(checkNetworkCapabilities());
   const std::string suffix = randomSuffix();
@@ -295,6 +323,8 @@ Result<VethNamespace> VethNamespace::create(const VethOptions& options) {
   ECSIM_TRY(runIp({"ip", "-n", name, "link", "set", "lo", "up"}));
   ECSIM_TRY(runIp({"ip", "-n", name, "link", "set", ns.masterInterface_, "up"}));
   ECSIM_TRY(runIp({"ip", "-n", name, "link", "set", ns.simulatorInterface_, "up"}));
+  ECSIM_TRY(waitOperational(name, ns.masterInterface_));
+  ECSIM_TRY(waitOperational(name, ns.simulatorInterface_));
   return ns;
 }
 
