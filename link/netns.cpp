@@ -265,17 +265,14 @@ Result<CommandOutput> runCommand(const std::vector<std::string>& argv) {
   return result;
 }
 
-namespace {
-
-// `ip link set up` returns before the kernel's link watcher has seen the carrier: until then the
-// interface's queueing discipline is "noop" and every frame sent is dropped without an error
-// (a test's first frame vanished this way on a busy CI machine). Wait until the interface is
-// operationally up and has its real queueing discipline.
 Status waitOperational(const std::string& netns, const std::string& interface) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
   std::string last;
   for (;;) {
-    auto out = runCommand({"ip", "-n", netns, "-o", "link", "show", interface});
+    std::vector<std::string> argv{"ip"};
+    if (!netns.empty()) argv.insert(argv.end(), {"-n", netns});
+    argv.insert(argv.end(), {"-o", "link", "show", interface});
+    auto out = runCommand(argv);
     if (out.ok() && out->exitCode == 0) {
       last = out->output;
       if (last.find("state UP") != std::string::npos &&
@@ -284,14 +281,13 @@ Status waitOperational(const std::string& netns, const std::string& interface) {
       }
     }
     if (std::chrono::steady_clock::now() >= deadline) {
-      return makeError(ErrorCode::kTimeout, "veth end " + interface + " in network namespace " +
-                                                netns + " not operational after 5 s: " + last);
+      return makeError(ErrorCode::kTimeout,
+                       interface + (netns.empty() ? "" : " in network namespace " + netns) +
+                           " not operational after 5 s: " + last);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
 }
-
-}  // namespace
 
 Result<VethNamespace> VethNamespace::create(const VethOptions& options) {
   ECSIM_TRY(checkNetworkCapabilities());

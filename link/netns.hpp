@@ -70,6 +70,12 @@ struct CommandOutput {
 // Runs a command to completion, collecting its output.
 Result<CommandOutput> runCommand(const std::vector<std::string>& argv);
 
+// Waits (up to 5 s) until `interface` (in `netns`, or here when empty) is operationally up with
+// its real queueing discipline. `ip link set up` returns before the kernel's link watcher has
+// seen the carrier; until then the qdisc is "noop" and every frame sent is dropped without an
+// error (a test's first frame vanished this way on a busy CI machine).
+Status waitOperational(const std::string& netns, const std::string& interface);
+
 struct VethOptions {
   int mtu{1500};  // an MTU of 1500 carries the largest EtherCAT frame (1514 bytes)
   bool disableIpv6{true};

@@ -77,6 +77,8 @@ Result<VethSetup> vethUp(const std::string& name, const VethSetupOptions& option
                                    "name", s.simulatorInterface}));
   if (made.ok()) made = configureEnd(s.netns, s.masterInterface);
   if (made.ok()) made = configureEnd(s.netns, s.simulatorInterface);
+  if (made.ok()) made = waitOperational(s.netns, s.masterInterface);
+  if (made.ok()) made = waitOperational(s.netns, s.simulatorInterface);
   if (!made.ok()) {
     (void)vethDown(name, options);
     return made.takeError();
