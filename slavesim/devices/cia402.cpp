@@ -1,5 +1,7 @@
 #include "slavesim/devices/cia402.hpp"
 
+#include "slavesim/devices/error_register.hpp"
+
 namespace ecsim::slavesim::devices::cia402 {
 
 std::uint32_t supportedModeBit(std::int8_t mode) {
@@ -91,22 +93,23 @@ std::string_view toString(Command command) {
 }
 
 std::uint8_t errorRegisterFor(std::uint16_t code) {
+  namespace er = error_register;
   if (code == kErrorReset) return 0;
-  std::uint8_t reg = 0x01;
+  std::uint8_t reg = er::kGeneric;
   switch (code >> 12) {
     case 0x2:
-      reg |= 0x02;
+      reg |= er::kCurrent;
       break;
     case 0x3:
-      reg |= 0x04;
+      reg |= er::kVoltage;
       break;
     case 0x4:
-      reg |= 0x08;
+      reg |= er::kTemperature;
       break;
     case 0x6:
     case 0x7:
     case 0x8:
-      reg = static_cast<std::uint8_t>(reg | ((code >> 8) == 0x81 ? 0x10 : 0x20));
+      reg |= (code >> 8) == 0x81 ? er::kCommunication : er::kDeviceProfile;
       break;
     default:
       break;

@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "slavesim/devices/device_state.hpp"
+#include "slavesim/devices/error_register.hpp"
 
 namespace ecsim::slavesim::devices {
 
@@ -20,7 +21,6 @@ namespace {
 constexpr SimTime kMaxCatchUp = 10 * kNsPerSecond;
 constexpr std::uint64_t kFollowingErrorOff = 0xFFFFFFFFu;
 constexpr std::int64_t kDefaultMaxTorquePerMille = 3000;
-constexpr std::uint16_t kErrorRegister = 0x1001;  // CiA 301 error register
 
 std::int32_t wrap32(std::int64_t v) {
   return static_cast<std::int32_t>(static_cast<std::uint32_t>(static_cast<std::uint64_t>(v)));
@@ -80,7 +80,7 @@ Status Cia402Drive::init() {
   obj_.feActual = ref(kFollowingErrorActualValue);
   obj_.targetVelocity = ref(kTargetVelocity);
   obj_.supportedModes = ref(kSupportedDriveModes);
-  obj_.errorRegister = ref(kErrorRegister);
+  obj_.errorRegister = ref(error_register::kIndex);
   if (params_.followingErrorWindow) obj_.feWindow.set(*params_.followingErrorWindow);
   if (params_.followingErrorTimeoutMs) obj_.feTimeout.set(*params_.followingErrorTimeoutMs);
   if (params_.maxTorquePerMille) obj_.maxTorque.set(*params_.maxTorquePerMille);

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "slavesim/devices/device_state.hpp"
+#include "slavesim/devices/error_register.hpp"
 
 namespace ecsim::slavesim::devices {
 namespace {
@@ -51,6 +52,7 @@ Result<std::unique_ptr<SsiEncoderTerminal>> SsiEncoderTerminal::create(
     return makeError(ErrorCode::kNotFound,
                      "SSI encoder terminal: dictionary has no counter value 0x6000:11");
   }
+  t->errorRegister_ = ObjectRef(od, error_register::kIndex, 0);
   t->latch(0);  // the first reading, so the inputs are valid from the start
   t->latched_ = false;
   return t;
@@ -106,6 +108,7 @@ void SsiEncoderTerminal::latch(SimTime now) {
   if (latched_ && now == lastLatch_) return;
   latched_ = true;
   lastLatch_ = now;
+  std::uint8_t reg = 0;
   for (Channel& c : channels_) {
     if (c.script) c.angle = c.script->value(now) * kTurn;
     const bool valid = c.faults == kNone;
@@ -120,7 +123,11 @@ void SsiEncoderTerminal::latch(SimTime now) {
     c.txPdoState.set(valid ? 0 : 1);
     if (valid) c.toggle = !c.toggle;
     c.txPdoToggle.set(c.toggle ? 1 : 0);
+    if (!valid) reg |= error_register::kGeneric;
+    if ((c.faults & kPower) != 0) reg |= error_register::kVoltage;
   }
+  errorRegisterValue_ = reg;
+  errorRegister_.set(reg);
 }
 
 }  // namespace ecsim::slavesim::devices

@@ -22,7 +22,12 @@
 //
 // Faults (setFault, the scenario action `encoder-fault`) are conditions outside the terminal
 // (wiring, encoder supply): they stay until cleared, through a power cycle of the terminal;
-// when cleared, the next reading is valid again and the toggle resumes.
+// when cleared, the next reading is valid again and the toggle resumes. A dictionary with the
+// CiA 301 error register 0x1001 (error_register.hpp) shows them there too, at each reading:
+// generic while any channel has a fault, voltage as well while an encoder supply has failed;
+// 0 again at the first reading after the last fault is cleared. (The ECS5001 has no mailbox
+// and so no 0x1001; the EJ5002's dictionary has none either. The terminal sends no
+// emergencies.)
 //
 // The inputs are latched at each firmware step, or at SYNC0 while the ESC generates it: one new
 // reading (and one toggle) per point in simulation time.
@@ -84,6 +89,9 @@ class SsiEncoderTerminal final : public Application {
   void setFault(unsigned channel, std::uint8_t faults);
   std::uint8_t fault(unsigned channel) const;
   const Encoder& encoder(unsigned channel) const { return channels_.at(channel - 1).encoder; }
+  // The 0x1001 value of the present faults (error_register.hpp), whether or not the dictionary
+  // has the object; updated at each reading.
+  std::uint8_t errorRegister() const { return errorRegisterValue_; }
 
   void step(coe::ObjectDictionary& od, AlState state, SimTime now) override;
   void sync(coe::ObjectDictionary& od, unsigned signal, AlState state, SimTime now) override;
@@ -106,6 +114,8 @@ class SsiEncoderTerminal final : public Application {
 
   EncoderTerminalOptions options_;
   std::vector<Channel> channels_;
+  ObjectRef errorRegister_;  // 0x1001, when present
+  std::uint8_t errorRegisterValue_{0};
   SimTime lastLatch_{0};
   bool latched_{false};
 };

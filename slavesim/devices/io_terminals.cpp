@@ -5,6 +5,8 @@
 #include <fstream>
 #include <string>
 
+#include "slavesim/devices/error_register.hpp"
+
 namespace ecsim::slavesim::devices {
 namespace {
 
@@ -184,6 +186,7 @@ Result<std::unique_ptr<AnalogInputTerminal>> AnalogInputTerminal::create(
     ch.filterMs = ObjectRef(od, set, kSubFilterMs);
     t->channels_.push_back(std::move(ch));
   }
+  t->errorRegister_ = ObjectRef(od, error_register::kIndex, 0);
   return t;
 }
 
@@ -258,6 +261,14 @@ void AnalogInputTerminal::update(SimTime now) {
     c.value.set(value);
     c.status.set(status);
   }
+  // Under- or overrange of a voltage input: generic + voltage, as long as a channel shows it.
+  std::uint8_t reg = 0;
+  for (const Channel& c : channels_) {
+    if ((c.status.getUnsigned() & kStatusError) != 0) {
+      reg |= error_register::kGeneric | error_register::kVoltage;
+    }
+  }
+  errorRegister_.set(reg);
   nextConversion_ += pending * period;
 }
 

@@ -18,7 +18,10 @@
 //                          -32768..32767; status bit 0 underrange, 1 overrange, 2-3 and 4-5
 //                          limit 1 and 2 (1 above, 2 below, 3 equal, 0 off), 6 error (under- or
 //                          overrange), 15 toggles with each new value. A channel without a script
-//                          is left as the dictionary holds it.
+//                          is left as the dictionary holds it. The CiA 301 error register 0x1001
+//                          (when present; error_register.hpp) is generic + voltage (0x05) while
+//                          any channel's status shows the error bit, 0 otherwise; updated with
+//                          each conversion. No emergencies.
 // With SYNC0 running (Application::syncActive()) inputs are latched, conversions published and
 // outputs applied at each SYNC0 pulse (sync()) instead of at every firmware step; outputs still
 // go to their safe state at once when the slave leaves OP.
@@ -145,6 +148,7 @@ class AnalogInputTerminal final : public Application {
 
   AnalogInputOptions options_;
   std::vector<Channel> channels_;
+  ObjectRef errorRegister_;  // 0x1001, when present
   SimTime nextConversion_{0};
   bool started_{false};
 };

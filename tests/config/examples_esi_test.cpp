@@ -312,6 +312,7 @@ TEST_F(ExamplesEsi, AnalogInputHasTwoStatusValueChannels) {
     EXPECT_EQ(p.bitLength(), 32u);
   }
   expectObjects(*d, {{0x1000, "UDINT", kRo, ""},
+                     {0x1001, "USINT", kRo, "T"},
                      {0x1008, "STRING(7)", kRo, ""},
                      {0x1009, "STRING(3)", kRo, ""},
                      {0x100A, "STRING(5)", kRo, ""},
@@ -326,7 +327,7 @@ TEST_F(ExamplesEsi, AnalogInputHasTwoStatusValueChannels) {
                      {0x6010, "DT6000", kRo, ""},
                      {0x8000, "DT8000", kRw, ""},
                      {0x8010, "DT8000", kRw, ""}});
-  EXPECT_EQ(d->dictionary.objects.size(), 15u);
+  EXPECT_EQ(d->dictionary.objects.size(), 16u);
   expectEntries(*d, {{0x6000, 0x01, "UINT"},
                      {0x6000, 0x11, "INT"},
                      {0x8000, 0x01, "BOOL"},
@@ -343,18 +344,18 @@ TEST_F(ExamplesEsi, AnalogInputHasTwoStatusValueChannels) {
 }
 
 const std::vector<ObjectSpec> kDriveObjects = {
-    {0x1000, "UDINT", kRo, ""},  {0x1008, "STRING(7)", kRo, ""}, {0x1018, "DT1018", kRo, ""},
-    {0x1C00, "DT1C00", kRo, ""}, {0x1C12, "DT1C12", kRw, ""},    {0x1C13, "DT1C13", kRw, ""},
-    {0x1C32, "DT1C32", kRo, ""}, {0x1C33, "DT1C33", kRo, ""},    {0x603F, "UINT", kRo, "T"},
-    {0x6040, "UINT", kRw, "R"},  {0x6041, "UINT", kRo, "T"},     {0x605A, "INT", kRw, ""},
-    {0x6060, "SINT", kRw, "R"},  {0x6061, "SINT", kRo, "T"},     {0x6064, "DINT", kRo, "T"},
-    {0x6065, "UDINT", kRw, ""},  {0x6066, "UINT", kRw, ""},      {0x606C, "DINT", kRo, "T"},
-    {0x6071, "INT", kRw, "R"},   {0x6072, "UINT", kRw, "R"},     {0x6077, "INT", kRo, "T"},
-    {0x607A, "DINT", kRw, "R"},  {0x607D, "DT607D", kRw, ""},    {0x6080, "UDINT", kRw, ""},
-    {0x6081, "UDINT", kRw, "R"}, {0x6083, "UDINT", kRw, "R"},    {0x6084, "UDINT", kRw, "R"},
-    {0x6098, "SINT", kRw, ""},   {0x6099, "DT6099", kRw, ""},    {0x609A, "UDINT", kRw, ""},
-    {0x60C2, "DT60C2", kRw, ""}, {0x60F4, "DINT", kRo, "T"},     {0x60FF, "DINT", kRw, "R"},
-    {0x6502, "UDINT", kRo, ""},
+    {0x1000, "UDINT", kRo, ""},  {0x1001, "USINT", kRo, "T"}, {0x1008, "STRING(7)", kRo, ""},
+    {0x1018, "DT1018", kRo, ""}, {0x1C00, "DT1C00", kRo, ""}, {0x1C12, "DT1C12", kRw, ""},
+    {0x1C13, "DT1C13", kRw, ""}, {0x1C32, "DT1C32", kRo, ""}, {0x1C33, "DT1C33", kRo, ""},
+    {0x603F, "UINT", kRo, "T"},  {0x6040, "UINT", kRw, "R"},  {0x6041, "UINT", kRo, "T"},
+    {0x605A, "INT", kRw, ""},    {0x6060, "SINT", kRw, "R"},  {0x6061, "SINT", kRo, "T"},
+    {0x6064, "DINT", kRo, "T"},  {0x6065, "UDINT", kRw, ""},  {0x6066, "UINT", kRw, ""},
+    {0x606C, "DINT", kRo, "T"},  {0x6071, "INT", kRw, "R"},   {0x6072, "UINT", kRw, "R"},
+    {0x6077, "INT", kRo, "T"},   {0x607A, "DINT", kRw, "R"},  {0x607D, "DT607D", kRw, ""},
+    {0x6080, "UDINT", kRw, ""},  {0x6081, "UDINT", kRw, "R"}, {0x6083, "UDINT", kRw, "R"},
+    {0x6084, "UDINT", kRw, "R"}, {0x6098, "SINT", kRw, ""},   {0x6099, "DT6099", kRw, ""},
+    {0x609A, "UDINT", kRw, ""},  {0x60C2, "DT60C2", kRw, ""}, {0x60F4, "DINT", kRo, "T"},
+    {0x60FF, "DINT", kRw, "R"},  {0x6502, "UDINT", kRo, ""},
 };
 
 const std::vector<EntrySpec> kDriveEntries = {
