@@ -214,7 +214,7 @@ TEST(SoemV1, SlaveinfoSdoReadsTheObjectDictionaries) {
   SoemRun run({});
   std::string out = run.run("bin-v1/slaveinfo", {"-sdo"}, std::chrono::seconds(120));
   EXPECT_NE(out.find("6 slaves found and configured."), std::string::npos) << out;
-  EXPECT_EQ(countMatches(out, "CoE Object Description found, 40 entries"), 2) << out;
+  EXPECT_EQ(countMatches(out, "CoE Object Description found, 41 entries"), 2) << out;
   EXPECT_EQ(countMatches(out, "CoE Object Description found, [0-9]+ entries"), 3) << out;
   // Identity object values as the SII says (vendor 0xE5C, product 0x7201).
   EXPECT_NE(out.find("0x00000e5c"), std::string::npos) << out;
