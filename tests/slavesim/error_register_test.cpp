@@ -3,7 +3,8 @@
 // ../shared/esi/STMBL_ECAT.xml writes USINT, BitSize 8, DefaultValue 0, ro), read by SDO upload
 // through frames: 0 at power-up, the fault's bits while a fault is present, 0 again when it is
 // reset or gone, and 0 after a power cycle. The SSI encoder terminal sets it too when its
-// dictionary has the object (the ECS5001 has no mailbox, so the test adds the object).
+// dictionary has the object (the ECS5001 has no mailbox and the real EJ5002 no 0x1001, so the
+// tests add the object).
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -12,6 +13,7 @@
 #include "slavesim/devices/device_models.hpp"
 #include "slavesim/devices/error_register.hpp"
 #include "tests/slavesim/drive_test_support.hpp"
+#include "tests/support/test_network.hpp"
 
 namespace ecsim::testing {
 namespace {
@@ -250,6 +252,62 @@ TEST(ErrorRegister, EncoderTerminalSetsItWhenItsDictionaryHasIt) {
   dev::encoderTerminalOf(slave)->setFault(1, dev::encoder_fault::kNone);
   poll();
   EXPECT_EQ(errorRegisterOf(slave), 0);
+}
+
+// The real EJ5002 (../shared/esi/Beckhoff_EJ5xxx.xml, revision 0x00110000) is a CoE device
+// whose dictionary has no 0x1001, like Beckhoff's other terminals: an upload is aborted with
+// "object does not exist". With the object added (as the AX2000's ESI in the same corpus
+// declares it: USINT, DefaultData 00) a master reads the encoder faults there by SDO.
+TEST(ErrorRegister, RealEj5002HasNoneAndWithOneAddedShowsItsChannelsFaults) {
+  const auto path = sharedDir() / "esi" / "Beckhoff_EJ5xxx.xml";
+  ECSIM_REQUIRE_SHARED(path);
+  auto file = loadEsiFile(path);
+  ASSERT_TRUE(file.ok()) << file.error().message();
+  const EsiDevice* found = nullptr;
+  for (const auto& d : file->devices) {
+    if (d.productCode == 0x138A2852 && d.revision == 0x00110000) found = &d;
+  }
+  ASSERT_NE(found, nullptr) << "EJ5002 revision 0x00110000";
+  ASSERT_TRUE(found->mailbox.coe);
+  EXPECT_EQ(found->dictionary.findObject(kErrorRegister), nullptr);
+  for (const bool added : {false, true}) {
+    EsiDevice device = *found;
+    if (added) {
+      EsiObject reg;
+      reg.index = kErrorRegister;
+      reg.names.push_back({1033, "Error Register"});
+      reg.type = "USINT";
+      reg.bitSize = 8;
+      reg.info.defaultData = {0x00};
+      reg.flags.access = EsiAccess::kReadOnly;
+      device.dictionary.objects.push_back(reg);
+    }
+    auto made = slavesim::makeSlaveFromEsi(*file, device, "EJ5002");
+    ASSERT_TRUE(made.ok()) << made.error().message();
+    topology::Segment seg;
+    seg.addSlave(std::move(made).value());
+    slavesim::Slave& slave = seg.slave(0);
+    SimTime now = kNsPerMs;
+    seg.pollSlaves(now);
+    one(seg, Command::kApwr, phys(0, reg::kConfiguredStationAddress.address), le16(kStation));
+    const auto& mbx = *slave.profile().mailbox;
+    MailboxMaster m(seg, kStation, mbx.outStart, mbx.outSize, mbx.inStart, mbx.inSize);
+    m.configureSyncManagers();
+    requestState(seg, kStation, 0x0002);
+    ASSERT_EQ(alStatus(seg, kStation), 0x0002);
+    if (!added) {
+      EXPECT_EQ(m.upload(kErrorRegister, 0).abort, 0x06020000u) << "object does not exist";
+      continue;
+    }
+    EXPECT_EQ(m.uploadValue<std::uint8_t>(kErrorRegister, 0), 0);
+    dev::encoderTerminalOf(slave)->setFault(2, dev::encoder_fault::kPower);
+    seg.pollSlaves(now += kNsPerMs);
+    EXPECT_EQ(m.uploadValue<std::uint8_t>(kErrorRegister, 0), er::kGeneric | er::kVoltage)
+        << "channel 2's supply";
+    dev::encoderTerminalOf(slave)->setFault(2, dev::encoder_fault::kNone);
+    seg.pollSlaves(now += kNsPerMs);
+    EXPECT_EQ(m.uploadValue<std::uint8_t>(kErrorRegister, 0), 0);
+  }
 }
 
 }  // namespace
