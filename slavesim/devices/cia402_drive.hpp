@@ -33,7 +33,7 @@
 //    over current 0x2310, and an encoder fault 0x7305 while Encoder::faulted()) sets 0x603F,
 //    the error register 0x1001 (when present; cia402::errorRegisterFor) and sends a CoE
 //    emergency (code, error register, 5 zero bytes) through the emergency sink; the fault
-//    reset sends the "error reset" emergency 0x0000.
+//    reset clears 0x603F and 0x1001 and sends the "error reset" emergency 0x0000.
 //  - quick stop (0x605A): 0 coast; 1/5 profile deceleration, 2/6 quick-stop deceleration,
 //    3/7 and 4/8 at the torque limit; 1-4 then Switch on disabled, 5-8 hold in Quick stop
 //    active. The fault reaction stops at the quick-stop deceleration (at most
