@@ -6,6 +6,7 @@
 
 #include "link/netns.hpp"
 #include "support/privileges.hpp"
+#include "support/readiness.hpp"
 #include "support/test_network.hpp"
 
 namespace ecsim::testing {
@@ -18,11 +19,17 @@ TEST(EcmasterVeth, ScanSdoAndCyclicOverARawSocket) {
   ECSIM_REQUIRE_NETWORK();
   auto ns = VethNamespace::create();
   ASSERT_TRUE(ns.ok()) << ns.error().message();
-  const std::string log = ::testing::TempDir() + "ecmaster_veth_serve.log";
-  auto server = ns->spawn({kEcsim, "serve", "--iface", ns->simulatorInterface(), "--quiet"},
+  const std::string log = uniqueTempPath("ecmaster_veth_serve.log");
+  // --rt: the network answers within the master's timeout whatever else the machine runs; as
+  // an ordinary process the server was seen 28 ms late on a loaded machine, a lost cyclic
+  // frame and exit status 1 (2 runs in 10 with three busy loops beside it).
+  auto server = ns->spawn({kEcsim, "serve", "--rt", "--iface", ns->simulatorInterface()},
                           SpawnOptions{log, log});
   ASSERT_TRUE(server.ok()) << server.error().message();
-  // 20 ms per try: the server is an ordinary process on a machine that may be busy (CI, two
+  // Its socket is open once it says it serves; a start under ASan on a busy machine can take
+  // longer than any number of quick tries.
+  ASSERT_TRUE(waitForText(log, "ecsim: serving", *server)) << readWholeFile(log);
+  // 20 ms per try: ecmaster is an ordinary process on a machine that may be busy (CI, two
   // cores, sanitizers); the default 2 ms x 3 tries is for a real-time set-up.
   const std::vector<std::string> base{kEcmaster, "--iface",      ns->masterInterface(),
                                       "--json",  "--timeout-ms", "20"};
@@ -32,13 +39,8 @@ TEST(EcmasterVeth, ScanSdoAndCyclicOverARawSocket) {
     EXPECT_TRUE(out.ok());
     return out.ok() ? *out : CommandOutput{-1, ""};
   };
-  // The simulator needs a moment to open its socket.
-  CommandOutput slaves;
-  for (int i = 0; i < 50; ++i) {
-    slaves = ecmaster({"slaves"});
-    if (slaves.exitCode == 0) break;
-  }
-  ASSERT_EQ(slaves.exitCode, 0) << slaves.output;
+  CommandOutput slaves = ecmaster({"slaves"});
+  ASSERT_EQ(slaves.exitCode, 0) << slaves.output << readWholeFile(log);
   auto list = nlohmann::json::parse(slaves.output, nullptr, false);
   ASSERT_TRUE(list.is_array()) << slaves.output;
   EXPECT_EQ(list.size(), 6u);  // the demo network `ecsim serve` serves by default
@@ -49,13 +51,22 @@ TEST(EcmasterVeth, ScanSdoAndCyclicOverARawSocket) {
 
   auto cyclic = ecmaster({"cyclic", "--cycle-us", "2000", "--seconds", "1"});
   ASSERT_EQ(cyclic.exitCode, 0) << cyclic.output;
-  auto stats = nlohmann::json::parse(cyclic.output, nullptr, false);
+  // The JSON summary is stdout; stderr shares the output here and carries a live line when
+  // the last cycle ends past the first second (a late wake-up on a busy machine).
+  const auto json = cyclic.output.rfind("\n{") == std::string::npos
+                        ? cyclic.output
+                        : cyclic.output.substr(cyclic.output.rfind("\n{") + 1);
+  auto stats = nlohmann::json::parse(json, nullptr, false);
   ASSERT_FALSE(stats.is_discarded()) << cyclic.output;
-  EXPECT_GT(stats["cycles"].get<int>(), 300);
+  // Nominally 500 cycles. ecmaster runs here as an ordinary process (no --rt), so the count is
+  // the machine's: 242 were seen with three busy loops beside a build on 2 cores. The check is
+  // that it cycled through the second, not at what rate.
+  EXPECT_GT(stats["cycles"].get<int>(), 100);
   EXPECT_EQ(stats["wkcErrors"], 0);
   EXPECT_EQ(stats["simulated"], false);
   auto stopped = server->stop();
   EXPECT_TRUE(stopped.ok());
+  std::filesystem::remove(log);
 }
 
 }  // namespace
