@@ -9,6 +9,7 @@
 
 #include "link/netns.hpp"
 #include "support/privileges.hpp"
+#include "support/readiness.hpp"
 #include "support/test_network.hpp"
 
 namespace ecsim::testing {
@@ -57,16 +58,16 @@ TEST(NetSetup, SigkilledServeLeavesAPairTheNextUpCleans) {
   auto ns = VethNamespace::create();
   ASSERT_TRUE(ns.ok()) << ns.error().message();
   const std::string name = uniqueName() + "k";
-  const std::string log = ::testing::TempDir() + "serve_veth_" + name + ".log";
+  const std::string log = uniqueTempPath("serve_veth_" + name + ".log");
   auto serve =
       ns->spawn({kEcsim, "serve", "--veth", name, "--slaves", "2"}, SpawnOptions{log, log});
   ASSERT_TRUE(serve.ok());
-  for (int i = 0; i < 50 && !linkExists(*ns, name + "s"); ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
+  // The pair exists once serve says it serves (a start under ASan on a busy machine can take
+  // longer than any fixed wait).
+  ASSERT_TRUE(waitForText(log, "ecsim: serving", *serve)) << readWholeFile(log);
   ASSERT_TRUE(linkExists(*ns, name));
   ASSERT_TRUE(serve->kill(SIGKILL).ok());
-  ASSERT_TRUE(serve->wait(std::chrono::seconds(5)).ok());
+  ASSERT_TRUE(serve->wait(kReadyTimeout).ok());
   EXPECT_TRUE(linkExists(*ns, name)) << "SIGKILL: no chance to clean up";
   auto up = ns->run({kEcsim, "net", "up", name});
   ASSERT_TRUE(up.ok());
@@ -83,19 +84,20 @@ TEST(NetSetup, ServeVethRemovesItsPairOnSigint) {
   auto ns = VethNamespace::create();
   ASSERT_TRUE(ns.ok()) << ns.error().message();
   const std::string name = uniqueName() + "i";
-  const std::string log = ::testing::TempDir() + "serve_veth_" + name + ".log";
+  const std::string log = uniqueTempPath("serve_veth_" + name + ".log");
   auto serve = ns->spawn({kEcsim, "serve", "--veth", name}, SpawnOptions{log, log});
   ASSERT_TRUE(serve.ok());
-  for (int i = 0; i < 50 && !linkExists(*ns, name + "s"); ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  // "ecsim: serving" is printed after serve installed its SIGINT handler: a SIGINT that came
+  // earlier (a fixed 200 ms after the pair appeared raced with a slow start) would end the
+  // process the default way, exit 130, the pair left behind.
+  ASSERT_TRUE(waitForText(log, "ecsim: serving", *serve)) << readWholeFile(log);
   ASSERT_TRUE(linkExists(*ns, name));
   ASSERT_TRUE(serve->kill(SIGINT).ok());
-  auto code = serve->wait(std::chrono::seconds(5));
+  auto code = serve->wait(kReadyTimeout);
   ASSERT_TRUE(code.ok());
-  EXPECT_EQ(*code, 0);
+  EXPECT_EQ(*code, 0) << readWholeFile(log);
   EXPECT_FALSE(linkExists(*ns, name));
+  std::filesystem::remove(log);
 }
 
 }  // namespace
