@@ -17,6 +17,7 @@
 #include "link/raw_socket_link.hpp"
 #include "protocol/frame.hpp"
 #include "support/privileges.hpp"
+#include "support/readiness.hpp"
 #include "support/test_network.hpp"
 
 namespace ecsim::testing {
@@ -30,6 +31,10 @@ std::string readText(const std::string& path) {
   s << in.rdbuf();
   return s.str();
 }
+
+// Waits for the end of `ecsim serve` after SIGINT: a bound against a hang, generous because a
+// sanitizer build on a busy machine is slow to finish and report.
+constexpr std::chrono::seconds kExitWait{30};
 
 class ServedNetwork {
  public:
@@ -51,29 +56,34 @@ class ServedNetwork {
   ChildProcess& child() { return child_; }
   RawSocketLink& link() { return *link_; }
 
-  // Sends one frame and waits for the answer with the same first index; nullopt on timeout.
+  // Sends one frame and waits for its answer: the same source MAC (with the locally
+  // administered bit an ESC sets) and the same first index; nullopt on timeout. The index
+  // alone is one byte: among the answers to random frames (the robustness test) one in 256
+  // would pass for ours. `wait` only guards against a hang: `ecsim serve` is an ordinary
+  // process, late by tens of milliseconds when the machine is busy (CI, sanitizers).
   std::optional<std::vector<std::uint8_t>> roundTrip(
-      ConstBytes frame, std::chrono::milliseconds wait = std::chrono::milliseconds(200)) {
+      ConstBytes frame, std::chrono::milliseconds wait = std::chrono::seconds(10)) {
     if (!link_->send(frame).ok()) return std::nullopt;
     std::array<std::uint8_t, kMaxFrameSize> buf{};
     auto deadline = std::chrono::steady_clock::now() + wait;
     while (std::chrono::steady_clock::now() < deadline) {
       auto n = link_->receive(buf, std::chrono::milliseconds(20));
-      if (n.ok() && *n > 17 && buf[17] == frame[17])
+      if (n.ok() && *n > 17 && answers(frame, ConstBytes(buf.data(), *n)))
         return std::vector<std::uint8_t>(buf.begin(), buf.begin() + *n);
     }
     return std::nullopt;
   }
 
   std::optional<std::pair<std::uint16_t, std::vector<std::uint8_t>>> datagram(
-      Command c, std::uint32_t address, std::vector<std::uint8_t> data) {
+      Command c, std::uint32_t address, std::vector<std::uint8_t> data,
+      std::chrono::milliseconds wait = std::chrono::seconds(10)) {
     std::array<std::uint8_t, kMaxFrameSize> buf{};
     FrameBuilder b(
         buf,
         EthernetHeader{kBroadcastMac, {0x02, 0, 0, 0, 0, 1}, std::nullopt, kEtherTypeEtherCat});
     if (!b.add(c, ++index_, address, data).ok()) return std::nullopt;
     auto len = b.finish();
-    auto answer = roundTrip(ConstBytes(buf.data(), *len));
+    auto answer = roundTrip(ConstBytes(buf.data(), *len), wait);
     if (!answer) return std::nullopt;
     EXPECT_EQ(answer->size(), *len) << "frame comes back with the same length";
     auto frame = EtherCatFrame::parse(std::span(answer->data(), answer->size()));
@@ -82,15 +92,26 @@ class ServedNetwork {
     return std::make_pair(d.wkc(), std::vector<std::uint8_t>(d.data().begin(), d.data().end()));
   }
 
-  // Waits until the simulator answers (it needs a moment to open its socket).
+  // Waits until the simulator answers (it needs a moment to open its socket; frames sent
+  // before are lost, so each try waits briefly and the next one is a new frame). 30 s: a
+  // start-up under sanitizers on a busy machine, never a normal wait.
   bool waitReady() {
-    for (int i = 0; i < 100; ++i) {
-      if (datagram(Command::kBrd, 0, {0, 0})) return true;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (std::chrono::steady_clock::now() < deadline && child_.running()) {
+      if (datagram(Command::kBrd, 0, {0, 0}, std::chrono::milliseconds(200))) return true;
     }
     return false;
   }
 
  private:
+  static bool answers(ConstBytes request, ConstBytes answer) {
+    for (std::size_t i = 6; i < 12; ++i) {
+      const std::uint8_t expected = i == 6 ? (request[i] | 0x02) : request[i];
+      if (answer[i] != expected) return false;
+    }
+    return answer[17] == request[17];
+  }
+
   const VethNamespace& ns_;
   ChildProcess child_;
   std::optional<RawSocketLink> link_;
@@ -104,7 +125,7 @@ TEST_P(ServeVeth, BroadcastReadCountsEverySlave) {
   const unsigned n = GetParam();
   auto ns = VethNamespace::create();
   ASSERT_TRUE(ns.ok()) << ns.error().message();
-  const std::string log = ::testing::TempDir() + "serve_" + std::to_string(n) + ".log";
+  const std::string log = uniqueTempPath("serve_" + std::to_string(n) + ".log");
   ServedNetwork net(*ns, n, "", log);
   ASSERT_TRUE(net.ok());
   ASSERT_TRUE(net.waitReady()) << readText(log);
@@ -122,7 +143,7 @@ TEST_P(ServeVeth, BroadcastReadCountsEverySlave) {
   EXPECT_EQ(r->first, 1);
   EXPECT_EQ(readLe16(r->second, 0), 0x1234);
   ASSERT_TRUE(net.child().kill(SIGINT).ok());
-  auto code = net.child().wait(std::chrono::seconds(5));
+  auto code = net.child().wait(kExitWait);
   ASSERT_TRUE(code.ok());
   EXPECT_EQ(*code, 0) << readText(log);
 }
@@ -135,7 +156,7 @@ TEST(ServeVethRobustness, SurvivesTenThousandMalformedFrames) {
   ECSIM_REQUIRE_NETWORK();
   auto ns = VethNamespace::create();
   ASSERT_TRUE(ns.ok()) << ns.error().message();
-  const std::string log = ::testing::TempDir() + "serve_fuzz.log";
+  const std::string log = uniqueTempPath("serve_fuzz.log");
   ServedNetwork net(*ns, 4, "", log);
   ASSERT_TRUE(net.ok());
   ASSERT_TRUE(net.waitReady()) << readText(log);
@@ -182,7 +203,7 @@ TEST(ServeVethRobustness, SurvivesTenThousandMalformedFrames) {
   ASSERT_TRUE(brd);
   EXPECT_EQ(brd->first, 4);
   ASSERT_TRUE(net.child().kill(SIGINT).ok());
-  ASSERT_TRUE(net.child().wait(std::chrono::seconds(5)).ok());
+  ASSERT_TRUE(net.child().wait(kExitWait).ok());
   std::string out = readText(log);
   auto pos = out.find("malformed dropped ");
   ASSERT_NE(pos, std::string::npos) << out;
@@ -197,8 +218,8 @@ TEST(ServeVethCapture, TsharkDecodesEveryFrameAsEtherCat) {
   }
   auto ns = VethNamespace::create();
   ASSERT_TRUE(ns.ok()) << ns.error().message();
-  const std::string pcap = ::testing::TempDir() + "serve_capture.pcap";
-  const std::string log = ::testing::TempDir() + "serve_capture.log";
+  const std::string pcap = uniqueTempPath("serve_capture.pcap");
+  const std::string log = uniqueTempPath("serve_capture.log");
   std::filesystem::remove(pcap);
   {
     ServedNetwork net(*ns, 3, pcap, log);
@@ -214,7 +235,7 @@ TEST(ServeVethCapture, TsharkDecodesEveryFrameAsEtherCat) {
     net.datagram(Command::kBwr, DatagramHeader::physical(0, 0x0120), {0x11, 0x00});
     net.datagram(Command::kFprd, DatagramHeader::physical(0x1001, 0x0130), {0, 0});
     ASSERT_TRUE(net.child().kill(SIGINT).ok());
-    auto code = net.child().wait(std::chrono::seconds(5));
+    auto code = net.child().wait(kExitWait);
     ASSERT_TRUE(code.ok());
     EXPECT_EQ(*code, 0);
   }
