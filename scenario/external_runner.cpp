@@ -38,6 +38,7 @@ namespace {
 constexpr SimTime kNoTime = INT64_MIN;
 constexpr auto kIdleWait = std::chrono::microseconds(500);  // timeline resolution when idle
 constexpr auto kPollInterval = std::chrono::milliseconds(5);
+constexpr auto kServingTimeout = std::chrono::seconds(30);  // the simulator's thread starting
 
 std::string ms(SimTime t) {
   return fmt::format("{:.3f} ms", static_cast<double>(t) / static_cast<double>(kNsPerMs));
@@ -512,7 +513,11 @@ ScenarioResult ExternalRun::execute() {
       if (thread.joinable()) thread.join();
     }
   } join{stop_, thread};
-  for (int i = 0; i < 5000 && !serving_; ++i) {
+  // The command starts once the simulator's thread serves. A count of 1 ms sleeps was no
+  // bound in time (each sleep lasts longer on a busy machine) and gave up silently; the
+  // deadline is generous (the thread only has to start) and only guards against a hang.
+  const auto servingDeadline = std::chrono::steady_clock::now() + kServingTimeout;
+  while (!serving_ && !serverEnded_ && std::chrono::steady_clock::now() < servingDeadline) {
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
 
