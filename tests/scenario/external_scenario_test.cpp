@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <csignal>
 #include <thread>
 
@@ -20,6 +21,7 @@
 #include "scenario/external_runner.hpp"
 #include "scenario/scenario.hpp"
 #include "support/privileges.hpp"
+#include "support/readiness.hpp"
 
 namespace ecsim::scenario {
 namespace {
@@ -148,13 +150,15 @@ TEST_F(ExternalScenario, OutputLinesAreJudgedByWhenTheyAppeared) {
 
 TEST_F(ExternalScenario, ACommandStillRunningAtTheEndIsStopped) {
   ECSIM_REQUIRE_NETWORK();
+  // The command would sleep 300 s; the run (300 ms after the start, plus the set-up, slow
+  // under ASan on a busy machine) ends well within 60 s only if the command was stopped.
   auto s = write(
       "<Master kind=\"external\" timeZero=\"start\" stopGraceMs=\"500\" "
-      "command=\"echo started; sleep 30\"/>",
+      "command=\"echo started; sleep 300\"/>",
       "<ExitStatus value=\"143\"/>\n<Output contains=\"started\"/>\n");
   const auto before = std::chrono::steady_clock::now();
   auto r = runExternalScenario(s);
-  EXPECT_LT(std::chrono::steady_clock::now() - before, std::chrono::seconds(10));
+  EXPECT_LT(std::chrono::steady_clock::now() - before, std::chrono::seconds(60));
   ASSERT_TRUE(r.error.empty()) << r.error;
   EXPECT_TRUE(r.passed()) << formatReport(r);
   EXPECT_NE(formatReport(r).find("command stopped (stopped with SIGTERM)"), std::string::npos)
@@ -188,24 +192,31 @@ TEST_F(ExternalScenario, ReportsDifferOnlyInMeasuredTimes) {
 
 TEST_F(ExternalScenario, SigintStopsTheCommandAndRemovesTheNamespace) {
   ECSIM_REQUIRE_NETWORK();
-  auto s = write("<Master kind=\"external\" timeZero=\"start\" command=\"sleep 30\"/>",
-                 "<ExitStatus value=\"0\"/>\n", "durationMs=\"60000\"");
+  // The command and the scenario would take 300 s and 600 s; the run ends well within 60 s
+  // (set-up slow under ASan on a busy machine included) only if the signal stopped it.
+  auto s = write("<Master kind=\"external\" timeZero=\"start\" command=\"sleep 300\"/>",
+                 "<ExitStatus value=\"0\"/>\n", "durationMs=\"600000\"");
   // SIGINT to this process once the run is under way (its namespace exists, the command has
-  // been started a moment later), as Ctrl-C in a terminal would.
-  std::thread interrupter([] {
+  // been started a moment later), as Ctrl-C in a terminal would. Only then: before the run
+  // has installed its handler a SIGINT would end the test process. The namespace is made
+  // after the handler; a fixed number of quick looks (about 5 s) could miss it on a slow start.
+  std::atomic<bool> sent{false};
+  std::thread interrupter([&sent] {
     const std::string tag = "ecsim-" + std::to_string(::getpid()) + "-";
-    for (int i = 0; i < 500; ++i) {
+    const bool underWay = ::ecsim::testing::waitUntil([&] {
       auto list = runCommand({"ip", "netns", "list"});
-      if (list.ok() && list->output.find(tag) != std::string::npos) break;
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
+      return list.ok() && list->output.find(tag) != std::string::npos;
+    });
+    if (!underWay) return;
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
     ::kill(::getpid(), SIGINT);
+    sent = true;
   });
   const auto before = std::chrono::steady_clock::now();
   auto r = runExternalScenario(s);
   interrupter.join();
-  EXPECT_LT(std::chrono::steady_clock::now() - before, std::chrono::seconds(10));
+  ASSERT_TRUE(sent) << "the run's namespace never appeared";
+  EXPECT_LT(std::chrono::steady_clock::now() - before, std::chrono::seconds(60));
   EXPECT_NE(r.error.find("interrupted by signal 2"), std::string::npos) << formatReport(r);
   EXPECT_FALSE(r.passed());
   expectNoNamespaceLeft();
@@ -286,7 +297,7 @@ TEST_F(ExternalScenario, SoemCableBreakThroughEcsimScenarioRun) {
                     junit.string(), (kSource / "scenarios/external/soem_cable_break.xml").string()},
                    SpawnOptions{log.string(), log.string()});
   ASSERT_TRUE(child.ok()) << child.error().message();
-  auto rc = child->wait(std::chrono::seconds(90));
+  auto rc = child->wait(std::chrono::seconds(240));  // a 5 s scenario; a bound against a hang
   const std::string out = readText(log);
   std::cout << out;
   ASSERT_TRUE(rc.ok()) << out;
