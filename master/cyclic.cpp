@@ -70,6 +70,7 @@ Status CyclicExchange::assemble() {
   outputs_.clear();
   inputs_.clear();
   dcDatagram_.reset();
+  dcLayoutIndex_.reset();
   EthernetHeader ethernet;
   ethernet.destination = kBroadcastMac;
   ethernet.source = source_;
@@ -89,7 +90,11 @@ Status CyclicExchange::assemble() {
       datagrams_[i] = {frames_.size(), k++, true};
       const bool systemTime = (d.command == Command::kFrmw || d.command == Command::kArmw) &&
                               (d.logicalStart >> 16) == reg::kSystemTime.address;
-      if (systemTime && !dcDatagram_) dcDatagram_ = datagrams_[i];
+      if (systemTime && !dcDatagram_) {
+        dcDatagram_ = datagrams_[i];
+        dcCommand_ = static_cast<std::uint8_t>(d.command);
+        dcLayoutIndex_ = i;
+      }
     }
     if (frames_.empty() && dcReference_ && !dcDatagram_) {
       auto view = builder.add(Command::kFrmw, 0,
@@ -97,6 +102,7 @@ Status CyclicExchange::assemble() {
                               std::uint16_t{8});
       if (!view.ok()) return view.takeError();
       dcDatagram_ = DatagramRef{0, k++, true};
+      dcCommand_ = static_cast<std::uint8_t>(Command::kFrmw);
     }
     if (k == 0) continue;  // nothing of this frame is sent in this state
     auto length = builder.finish();
@@ -155,6 +161,11 @@ Status CyclicExchange::send(Transport& transport, ConstBytes image, SimTime now)
     std::memcpy(frames_[c.frame]->tx().data() + c.frameOffset, image.data() + c.imageOffset,
                 c.length);
   }
+  if (dcDatagram_) {
+    CachedFrame& frame = *frames_[dcDatagram_->frame];
+    frame.tx()[frame.datagramOffset(dcDatagram_->index)] =
+        dcHeld_ ? static_cast<std::uint8_t>(Command::kNop) : dcCommand_;
+  }
   ++statistics_.cycles;
   if (period_ > 0 && lastSend_) {
     const SimTime deviation = (now - *lastSend_) - period_;
@@ -176,7 +187,7 @@ bool CyclicExchange::pending() const {
 }
 
 std::optional<std::uint64_t> CyclicExchange::dcSystemTime() const {
-  if (!dcDatagram_ || dcDatagram_->frame >= frames_.size()) return std::nullopt;
+  if (!dcDatagram_ || dcHeld_ || dcDatagram_->frame >= frames_.size()) return std::nullopt;
   const CachedFrame& frame = *frames_[dcDatagram_->frame];
   if (frame.state() != DatagramState::kReceived) return std::nullopt;
   const std::size_t at = frame.datagramOffset(dcDatagram_->index) + kDatagramHeaderSize;
@@ -210,7 +221,7 @@ CycleResult CyclicExchange::finish(Bytes image) {
     std::memcpy(image.data() + c.imageOffset, frame.rx().data() + c.frameOffset, c.length);
   }
   for (std::size_t i = 0; i < datagrams_.size(); ++i) {
-    if (!datagrams_[i].active) continue;
+    if (!datagrams_[i].active || (dcHeld_ && dcLayoutIndex_ == i)) continue;
     const CachedFrame& frame = *frames_[datagrams_[i].frame];
     if (frame.state() != DatagramState::kReceived) continue;
     const std::uint16_t wkc = frame.rxWkc(datagrams_[i].index);

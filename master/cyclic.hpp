@@ -114,8 +114,16 @@ class CyclicExchange {
   // distributes the reference time and drives the slaves' drift control loops. nullopt: none.
   // A layout that has its own FRMW/ARMW of 0x0910 (an ENI's) uses that one instead.
   void setDcReference(std::optional<std::uint16_t> station) { dcReference_ = station; }
-  // The reference clock's system time carried back by the last answered frame.
+  // The reference clock's system time carried back by the last answered frame (nullopt while
+  // the distribution is held).
   std::optional<std::uint64_t> dcSystemTime() const;
+  // Hold the distribution while the reference clock's time cannot be trusted (it was
+  // power-cycled and has not been given its offset back): the FRMW/ARMW is sent as a NOP, which
+  // no slave executes, so the others' drift loops are not driven by a clock that started over;
+  // they run on with what they learnt. A held datagram's WKC is not checked. Takes effect
+  // from the next send().
+  void holdDcDistribution(bool hold) { dcHeld_ = hold; }
+  bool dcDistributionHeld() const { return dcHeld_; }
 
   // The WKCs a datagram is accepted with: the layout's expected value, unless widened or
   // lowered (recovery does, while slaves are missing or being reconfigured);
@@ -156,7 +164,10 @@ class CyclicExchange {
   SimTime deadline_{0};
   std::optional<SimTime> lastSend_;
   std::optional<std::uint16_t> dcReference_;
-  std::optional<DatagramRef> dcDatagram_;  // the FRMW/ARMW of the reference's system time
+  std::optional<DatagramRef> dcDatagram_;     // the FRMW/ARMW of the reference's system time
+  std::uint8_t dcCommand_{0};                 // its command byte (FRMW or ARMW)
+  std::optional<std::size_t> dcLayoutIndex_;  // its layout datagram, for an ENI's own
+  bool dcHeld_{false};
   MacAddress source_{};
   std::optional<AlState> state_;
 };

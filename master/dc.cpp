@@ -76,12 +76,27 @@ std::vector<SimTime> computeDcDelays(const std::vector<SlaveInfo>& slaves,
 
 std::optional<DcRecovery> dcRecoveryFor(const DcSetup& setup, const std::vector<SlaveInfo>& slaves,
                                         std::size_t position, SimTime sync0Margin) {
-  if (!setup.reference || *setup.reference >= slaves.size() || position == *setup.reference ||
-      position >= setup.dc.size() || !setup.dc[position] || position >= setup.delays.size()) {
+  if (!setup.reference || *setup.reference >= slaves.size() || position >= setup.dc.size() ||
+      !setup.dc[position] || position >= setup.delays.size()) {
     return std::nullopt;
   }
+  std::size_t source = *setup.reference;
+  if (position == source) {
+    // The reference clock itself: the time is in the others' clocks.
+    std::optional<std::size_t> other;
+    for (std::size_t i = 0; i < setup.dc.size() && i < slaves.size() && i < setup.delays.size();
+         ++i) {
+      if (setup.dc[i] && i != position) {
+        other = i;
+        break;
+      }
+    }
+    if (!other) return std::nullopt;
+    source = *other;
+  }
   DcRecovery r;
-  r.referenceStation = slaves[*setup.reference].station;
+  r.sourceStation = slaves[source].station;
+  r.sourceDelay = setup.delays[source];
   r.delay = setup.delays[position];
   r.sync0Margin = sync0Margin;
   if (std::find(setup.sync0.begin(), setup.sync0.end(), position) != setup.sync0.end() &&
@@ -94,9 +109,9 @@ std::optional<DcRecovery> dcRecoveryFor(const DcSetup& setup, const std::vector<
   return r;
 }
 
-std::uint64_t recoveredDcOffset(std::uint64_t referenceLocal, std::uint64_t referenceOffset,
+std::uint64_t recoveredDcOffset(std::uint64_t sourceLocal, std::uint64_t sourceOffset,
                                 std::uint64_t slaveLocal, SimTime delay) {
-  return referenceLocal + referenceOffset + static_cast<std::uint64_t>(delay) - slaveLocal;
+  return sourceLocal + sourceOffset + static_cast<std::uint64_t>(delay) - slaveLocal;
 }
 
 std::uint64_t nextSync0Time(std::uint64_t gridStart, SimTime cycle, std::uint64_t earliest) {

@@ -103,18 +103,25 @@ class DcInitTask final : public Task {
 };
 
 // What a recovery needs to give a power-cycled DC slave its clock back (SlaveRecoveryTask's
-// stage kDc, in PREOP before PREOP->SAFEOP):
-//   1. BWR 0x0900: every ESC latches its local time at that datagram in 0x0918, the reference
-//      and this slave at the same point of the same frame, as the start-up's latch does;
-//   2. FPRD the reference's 0x0918-0x0927 (latched local time and its offset: its system time
+// stage kDc, in PREOP before PREOP->SAFEOP). The time comes from a "source" clock that kept
+// running: the reference clock, or, when the slave is the reference clock itself, the first
+// other slave the master set up for DC (its system time is the reference's own, the delay
+// between them accounted for), so that the recovered reference continues the system time the
+// others run on instead of starting over from its power-up.
+//   1. FPWR 0x0930 = 0x1000 (its drift loop restarted: a power-cycled slave has no station
+//      address, so each FRMW of the reference time wrote it as one of the others), then BWR
+//      0x0900: every ESC latches its local time at that datagram in 0x0918, the source and this
+//      slave at the same point of the same frame, as the start-up's latch does;
+//   2. FPRD the source's 0x0918-0x0927 (latched local time and its offset: its system time
 //      at the latch) and the slave's 0x0918;
 //   3. FPWR 0x0928 = delay, 0x0920 = recoveredDcOffset(), 0x0930 = 0x1000 (restart the drift
 //      filter, as start-up does); with SYNC0: 0x0981 = 0, 0x09A0 = cycle, 0x0990 =
-//      nextSync0Time(grid, reference's system time at the latch + margin), 0x0980/0x0981 =
+//      nextSync0Time(grid, source's system time at the latch + margin), 0x0980/0x0981 =
 //      assignActivate.
 struct DcRecovery {
-  std::uint16_t referenceStation{0};
-  SimTime delay{0};  // 0x0928, from DcSetup::delays
+  std::uint16_t sourceStation{0};  // the running clock the time is taken from
+  SimTime sourceDelay{0};          // its 0x0928 (0 for the reference clock)
+  SimTime delay{0};                // 0x0928 of the recovered slave, from DcSetup::delays
   bool sync0{false};
   std::uint16_t assignActivate{0};  // 0x0980 word
   std::uint64_t sync0Start{0};      // the grid the others run on: sync0Start + k * sync0Cycle
@@ -123,15 +130,18 @@ struct DcRecovery {
 };
 
 // The recovery's data for the slave at `position`; nullopt when the master did not set it up
-// for distributed clocks (no DC set-up, no DC unit, or the reference clock itself).
+// for distributed clocks (no DC set-up, no DC unit), or when it is the reference clock and no
+// other slave has a clock to take the time from.
 std::optional<DcRecovery> dcRecoveryFor(const DcSetup& setup, const std::vector<SlaveInfo>& slaves,
                                         std::size_t position, SimTime sync0Margin);
 
 // 0x0920 for a slave whose local time was `slaveLocal` when one datagram passed it, the
-// reference's local time being `referenceLocal` (offset `referenceOffset`) when the same datagram
-// passed the reference `delay` earlier: its system time then equals the reference's at once,
-// modulo 2^64 (the start-up's offsets leave a lag of the delay for the drift loop to take up).
-std::uint64_t recoveredDcOffset(std::uint64_t referenceLocal, std::uint64_t referenceOffset,
+// source clock's local time being `sourceLocal` (offset `sourceOffset`) when the same datagram
+// passed the source: `delay` = the slave's 0x0928 minus the source's, the time the datagram
+// took from the source to the slave (negative when the slave lies before the source, as the
+// reference clock does). Its system time then equals the source's at once, modulo 2^64 (the
+// start-up's offsets leave a lag of the delay for the drift loop to take up).
+std::uint64_t recoveredDcOffset(std::uint64_t sourceLocal, std::uint64_t sourceOffset,
                                 std::uint64_t slaveLocal, SimTime delay);
 
 // The first point of the grid gridStart + k * cycle (k >= 0) at or after `earliest`; gridStart

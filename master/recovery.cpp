@@ -13,7 +13,7 @@ constexpr std::uint16_t kEepromReadLength = static_cast<std::uint16_t>(
 constexpr std::size_t kEepromDataOffset = reg::kSiiData.address - reg::kSiiControlStatus.address;
 constexpr std::size_t kIdentityBytes = 8;             // vendor id, product code
 constexpr std::uint16_t kPdoAssignmentBase = 0x1C10;  // + SM number
-// The reference's latched local time 0x0918 and its offset 0x0920 in one read.
+// The source clock's latched local time 0x0918 and its offset 0x0920 in one read.
 constexpr std::uint16_t kDcLatchAndOffsetLength = static_cast<std::uint16_t>(
     reg::kSystemTimeOffset.end() - reg::kReceiveTimeEcatProcessingUnit.address);
 constexpr std::uint16_t kSpeedCounterRestart = 0x1000;  // 0x0930, as the DC set-up writes it
@@ -232,8 +232,14 @@ void SlaveRecoveryTask::enter(Stage stage, SimTime now) {
         enter(Stage::kProcess, now);
         return;
       }
-      // One datagram latches the reference's and this slave's local time (0x0918) at the
-      // same point of the frame; the count of slaves is not checked.
+      // Its drift loop restarted first: until it has its offset it is not in the group, but
+      // its clock was written times meant for the others (an FRMW's write reaches every slave
+      // but the addressed one, and a power-cycled slave has lost its address), which a real
+      // ESC follows at its fastest rate. Then one datagram latches the source clock's and this
+      // slave's local time (0x0918) at the same point of the frame; the count of slaves that
+      // latch is not checked.
+      batch_.add().fpwr(slave_.station, reg::kSpeedCounterStart.address,
+                        le(kSpeedCounterRestart));
       batch_.add().prepare(Command::kBwr,
                            DatagramHeader::physical(0, reg::kReceiveTimePort0.address),
                            std::uint16_t{4}, 0);
@@ -404,12 +410,16 @@ bool SlaveRecoveryTask::stepDc(SimTime now) {
   if (batch_.pending()) return true;
   const DcRecovery& dc = *dc_;
   if (sub_ == Sub::kDcLatch) {
-    if (!batch_[0].received()) {
-      fail(makeError(ErrorCode::kTimeout, "time latch: " + batch_[0].describe()));
+    if (!batch_[0].wkcOk()) {
+      fail(makeError(ErrorCode::kWorkingCounter, "drift loop restart: " + batch_[0].describe()));
+      return false;
+    }
+    if (!batch_[1].received()) {
+      fail(makeError(ErrorCode::kTimeout, "time latch: " + batch_[1].describe()));
       return false;
     }
     batch_.clear();
-    batch_.add().fprd(dc.referenceStation, reg::kReceiveTimeEcatProcessingUnit.address,
+    batch_.add().fprd(dc.sourceStation, reg::kReceiveTimeEcatProcessingUnit.address,
                       kDcLatchAndOffsetLength);
     batch_.add().fprd(slave_.station, reg::kReceiveTimeEcatProcessingUnit.address,
                       reg::kReceiveTimeEcatProcessingUnit.width);
@@ -418,8 +428,8 @@ bool SlaveRecoveryTask::stepDc(SimTime now) {
     return true;
   }
   if (auto s = batch_.check(); !s.ok()) {
-    fail(makeError(s.error().code, (sub_ == Sub::kDcRead ? "latched times (reference clock " +
-                                                               hex(dc.referenceStation, 4) + "): "
+    fail(makeError(s.error().code, (sub_ == Sub::kDcRead ? "latched times (clock of " +
+                                                               hex(dc.sourceStation, 4) + "): "
                                                          : std::string("DC registers: ")) +
                                        s.error().context));
     return false;
@@ -428,22 +438,23 @@ bool SlaveRecoveryTask::stepDc(SimTime now) {
     enter(Stage::kProcess, now);
     return true;
   }
-  // kDcRead answered: the reference's system time at the latch, and this slave's local time.
-  const std::uint64_t referenceLocal = readLe64(batch_[0].data(), 0);
-  const std::uint64_t referenceOffset =
+  // kDcRead answered: the source's system time at the latch, and this slave's local time.
+  const std::uint64_t sourceLocal = readLe64(batch_[0].data(), 0);
+  const std::uint64_t sourceOffset =
       readLe64(batch_[0].data(),
                reg::kSystemTimeOffset.address - reg::kReceiveTimeEcatProcessingUnit.address);
   const std::uint64_t slaveLocal = readLe64(batch_[1].data(), 0);
-  const std::uint64_t referenceTime = referenceLocal + referenceOffset;
+  const std::uint64_t sourceTime = sourceLocal + sourceOffset;
   batch_.clear();
   batch_.add().fpwr(slave_.station, reg::kSystemTimeDelay.address,
                     le(static_cast<std::uint32_t>(dc.delay)));
-  batch_.add().fpwr(slave_.station, reg::kSystemTimeOffset.address,
-                    le(recoveredDcOffset(referenceLocal, referenceOffset, slaveLocal, dc.delay)));
+  batch_.add().fpwr(
+      slave_.station, reg::kSystemTimeOffset.address,
+      le(recoveredDcOffset(sourceLocal, sourceOffset, slaveLocal, dc.delay - dc.sourceDelay)));
   batch_.add().fpwr(slave_.station, reg::kSpeedCounterStart.address, le(kSpeedCounterRestart));
   if (dc.sync0) {
     const std::uint64_t start = nextSync0Time(
-        dc.sync0Start, dc.sync0Cycle, referenceTime + static_cast<std::uint64_t>(dc.sync0Margin));
+        dc.sync0Start, dc.sync0Cycle, sourceTime + static_cast<std::uint64_t>(dc.sync0Margin));
     batch_.add().fpwr(slave_.station, reg::kDcActivation.address, le(std::uint8_t{0}));
     batch_.add().fpwr(slave_.station, reg::kSync0CycleTime.address,
                       le(static_cast<std::uint32_t>(dc.sync0Cycle)));

@@ -70,6 +70,9 @@ class SlaveSetup {
     (void)slave;
     return std::nullopt;
   }
+  // The position of the reference clock, when the master set up distributed clocks: while it
+  // is out, the cyclic distribution of its time is held (CyclicExchange::holdDcDistribution).
+  virtual std::optional<std::size_t> dcReference() const { return std::nullopt; }
 };
 
 // The CoE downloads that give a slave the PDO assignment `data` describes (0x1C10+SM: sub 0
@@ -94,6 +97,9 @@ class MasterSlaveSetup final : public SlaveSetup {
         sync0Margin_(sync0Margin) {}
   std::vector<SetupWrite> writesFor(const SlaveInfo& slave, AlState target) const override;
   std::optional<DcRecovery> dcRecovery(const SlaveInfo& slave) const override;
+  std::optional<std::size_t> dcReference() const override {
+    return dc_ != nullptr ? dc_->reference : std::nullopt;
+  }
 
  private:
   const std::vector<SlaveProcessData>& processData_;

@@ -119,6 +119,71 @@ TEST(CyclicTest, NoAllocationPerCycleInTheMaster) {
   EXPECT_EQ(net.segment().slave(0).esc().pdiOutputs(0)[0], 199);
 }
 
+// An FRMW of the reference's system time given by the layout (as an ENI's Cmd with a Cnt) is
+// sent as a NOP while the distribution is held, its WKC then not checked; released, it is the
+// FRMW again with its WKC checked.
+TEST(CyclicTest, HeldDcDistributionGoesAsANopAndIsNotCounted) {
+  SimNetwork net;
+  net.segment().addSlave(makeDemoSlave(0x7201, "DriveA"));
+  net.segment().addSlave(makeDemoSlave(0x7201, "DriveB"));
+  net.segment().wireLine();
+  net.start();
+  master::Master m(net.masterLink(), net.bus());
+  ASSERT_TRUE(m.start().ok());
+  master::ProcessImageLayout layout = m.layout();
+  master::LogicalDatagram frmw;
+  frmw.command = Command::kFrmw;
+  frmw.logicalStart = m.slaves()[0].station | std::uint32_t{reg::kSystemTime.address} << 16;
+  frmw.length = 8;
+  frmw.expectedWkc = 2;  // read at DriveA, written at DriveB
+  frmw.slaves = {0, 1};
+  frmw.contributions = {1, 1};
+  layout.datagrams.push_back(frmw);
+  master::CyclicExchange cyclic;
+  ASSERT_TRUE(cyclic.build(layout, {2, 0, 0, 0, 0, 9}).ok());
+  std::vector<std::uint8_t> image(layout.size(), 0);
+  master::Transport& transport = m.transport();
+  auto exchange = [&] {
+    EXPECT_TRUE(cyclic.send(transport, image, net.clock().now()).ok());
+    transport.poll(net.clock().now());
+    while (cyclic.pending()) {
+      net.bus().wait(net.clock().now() + transport.options().timeout);
+      transport.poll(net.clock().now());
+    }
+    return cyclic.finish(image);
+  };
+  auto commandSent = [&] {
+    auto frame = ConstEtherCatFrame::parse(cyclic.frame(0).tx());
+    EXPECT_TRUE(frame.ok());
+    Command last = Command::kLrw;
+    for (auto d : *frame) last = d.command();  // the FRMW is the frame's last datagram
+    return last;
+  };
+  const std::size_t index = layout.datagrams.size() - 1;
+
+  auto result = exchange();
+  EXPECT_EQ(result.wkcErrors, 0u);
+  EXPECT_EQ(commandSent(), Command::kFrmw);
+  EXPECT_EQ(cyclic.receivedWkc(index), std::optional<std::uint16_t>(2));
+  EXPECT_TRUE(cyclic.dcSystemTime());
+
+  cyclic.holdDcDistribution(true);
+  result = exchange();
+  EXPECT_EQ(commandSent(), Command::kNop);
+  EXPECT_EQ(cyclic.receivedWkc(index), std::optional<std::uint16_t>(0)) << "no slave executes it";
+  EXPECT_EQ(result.wkcErrors, 0u) << "a held datagram's WKC is not checked";
+  EXPECT_FALSE(cyclic.dcSystemTime());
+
+  cyclic.holdDcDistribution(false);
+  result = exchange();
+  EXPECT_EQ(commandSent(), Command::kFrmw);
+  EXPECT_EQ(result.wkcErrors, 0u);
+  EXPECT_EQ(cyclic.receivedWkc(index), std::optional<std::uint16_t>(2));
+  // The check is back: the same FRMW with another expectation is an error again.
+  cyclic.setExpectedWkc(index, 3, 3);
+  EXPECT_EQ(exchange().wkcErrors, 1u);
+}
+
 TEST(CyclicTest, CounterCatchesAnAllocation) {
   // The counting itself works (so the test above can fail).
   gAllocations = 0;

@@ -66,10 +66,10 @@ TEST(DcRecoveryMathTest, OnlySlavesSetUpForDcGetAStep) {
   setup.sync0Start = 1'000'000'000;
   setup.sync0Cycle = kNsPerMs;
   EXPECT_FALSE(master::dcRecoveryFor(setup, slaves, 0, kNsPerMs)) << "no DC unit";
-  EXPECT_FALSE(master::dcRecoveryFor(setup, slaves, 1, kNsPerMs)) << "the reference itself";
   auto plain = master::dcRecoveryFor(setup, slaves, 2, kNsPerMs);
   ASSERT_TRUE(plain);
-  EXPECT_EQ(plain->referenceStation, 0x1002);
+  EXPECT_EQ(plain->sourceStation, 0x1002) << "the time comes from the reference clock";
+  EXPECT_EQ(plain->sourceDelay, 0);
   EXPECT_EQ(plain->delay, 1100);
   EXPECT_FALSE(plain->sync0);
   auto synced = master::dcRecoveryFor(setup, slaves, 3, 7 * kNsPerMs);
@@ -82,6 +82,35 @@ TEST(DcRecoveryMathTest, OnlySlavesSetUpForDcGetAStep) {
   EXPECT_EQ(synced->sync0Margin, 7 * kNsPerMs);
 }
 
+TEST(DcRecoveryMathTest, TheReferenceClockTakesTheTimeFromTheNextClock) {
+  std::vector<master::SlaveInfo> slaves(4);
+  for (std::size_t i = 0; i < slaves.size(); ++i) {
+    slaves[i].position = i;
+    slaves[i].station = static_cast<std::uint16_t>(0x1001 + i);
+  }
+  DcSetup setup;
+  setup.reference = 1;
+  setup.dc = {false, true, true, true};
+  setup.delays = {0, 0, 1100, 2200};
+  auto reference = master::dcRecoveryFor(setup, slaves, 1, kNsPerMs);
+  ASSERT_TRUE(reference);
+  EXPECT_EQ(reference->sourceStation, 0x1003) << "the first other slave set up for DC";
+  EXPECT_EQ(reference->sourceDelay, 1100);
+  EXPECT_EQ(reference->delay, 0);
+  // The reference alone has nobody to take the time from.
+  setup.dc = {false, true, false, false};
+  EXPECT_FALSE(master::dcRecoveryFor(setup, slaves, 1, kNsPerMs));
+}
+
+TEST(DcRecoveryMathTest, AClockBeforeItsSourceLagsBehindItByTheDelay) {
+  // The datagram passed the recovered reference at its local time 50 and the source 1100 ns
+  // later at system time 9e17 + 2000: the reference's system time at its own latch was
+  // 1100 ns earlier than the source's.
+  const std::uint64_t offset =
+      master::recoveredDcOffset(2'000, 900'000'000'000'000'000ull, 50, 0 - 1100);
+  EXPECT_EQ(50 + offset, 900'000'000'000'000'000ull + 2'000 - 1'100);
+}
+
 // ---- a power-cycled drive on the demo line -----------------------------------------------------
 
 enum : std::size_t { kCoupler, kDi, kDo, kAi, kDrive1, kDrive2, kCount };
@@ -92,6 +121,10 @@ class DcRecoveryTest : public ::testing::Test {
     addDemoSlaves(net_, 2);
     net_.segment().setClock(kDrive1, 3'000'000, 40.0);
     net_.segment().setClock(kDrive2, -7'000'000, -60.0);
+    startMaster();
+    ASSERT_EQ(master_->dcSetup().sync0, (std::vector<std::size_t>{kDrive1, kDrive2}));
+  }
+  void startMaster() {
     net_.start();
     master::MasterOptions options;
     options.dc.enable = true;
@@ -99,9 +132,7 @@ class DcRecoveryTest : public ::testing::Test {
     master_ = std::make_unique<master::Master>(net_.masterLink(), net_.bus(), options);
     auto status = master_->start();
     ASSERT_TRUE(status.ok()) << status.error().message();
-    const DcSetup& setup = master_->dcSetup();
-    ASSERT_EQ(setup.sync0, (std::vector<std::size_t>{kDrive1, kDrive2}));
-    ASSERT_TRUE(setup.reference);
+    ASSERT_TRUE(master_->dcSetup().reference);
     master_->resetStatistics();
   }
   void run(std::uint64_t n) {
@@ -134,6 +165,11 @@ class DcRecoveryTest : public ::testing::Test {
   // The simulation time at which drive i's SYNC0 unit fires for system time `t`.
   SimTime pulseInstant(std::size_t i, std::uint64_t t) {
     return esc(i).dcClock().globalTime(static_cast<SimTime>(t - esc(i).reg64(0x0920)));
+  }
+  // Slave i's system time now: its local time plus its offset 0x0920.
+  std::int64_t systemTime(std::size_t i) {
+    const auto local = static_cast<std::uint64_t>(esc(i).dcClock().localTime(net_.clock().now()));
+    return static_cast<std::int64_t>(local + esc(i).reg64(0x0920));
   }
 
   SimNetwork net_;
@@ -185,6 +221,76 @@ TEST_F(DcRecoveryTest, PowerCycledDriveGetsItsClockAndSync0BackOnTheRunningGrid)
   const SimTime apart = pulseInstant(kDrive2, t) - pulseInstant(kDrive1, t);
   EXPECT_LT(std::abs(apart), 100) << "SYNC0 at system time " << t;
   // And the cycle goes on without errors once all are back.
+  master_->resetStatistics();
+  run(100);
+  EXPECT_EQ(master_->statistics().wkcErrors, 0u);
+}
+
+// ---- a power-cycled reference clock -----------------------------------------------------------
+
+// Three drives in a line: the first is the reference clock, all three run SYNC0.
+class DcReferenceRecoveryTest : public DcRecoveryTest {
+ protected:
+  void SetUp() override {
+    for (const char* name : {"DriveA", "DriveB", "DriveC"}) {
+      net_.segment().addSlave(makeDemoSlave(0x7201, name));
+    }
+    net_.segment().wireLine();
+    net_.segment().setClock(0, 5'000'000, 30.0);
+    net_.segment().setClock(1, 3'000'000, -40.0);
+    net_.segment().setClock(2, -7'000'000, 60.0);
+    startMaster();
+    ASSERT_EQ(*master_->dcSetup().reference, 0u);
+    ASSERT_EQ(master_->dcSetup().sync0, (std::vector<std::size_t>{0, 1, 2}));
+  }
+};
+
+TEST_F(DcReferenceRecoveryTest, PowerCycledReferenceContinuesTheSystemTimeOfTheOthers) {
+  run(200);
+  const DcSetup& setup = master_->dcSetup();
+  const auto cycle = static_cast<std::uint64_t>(setup.sync0Cycle);
+  ASSERT_LT(std::abs(systemTime(0) - systemTime(1)), 100);
+
+  auto& reference = net_.segment().slave(0);
+  reference.powerOff();
+  reference.powerOn(net_.clock().now());
+  ASSERT_GT(std::abs(systemTime(0) - systemTime(1)), 10'000'000)
+      << "the power cycle restarted the reference's clock";
+
+  // Until the master notices, each FRMW still writes the others what the frame carried (the
+  // same window as with any master). Once it has seen the reference lost, no time is
+  // distributed (the FRMW goes as a NOP) until the reference has its offset back: its restarted
+  // time never reaches the others' drift loops, which run on with what they learnt. Each write
+  // of 0x0910 sets 0x092C, so a held distribution leaves 0x092C as it was.
+  std::optional<std::pair<SimTime, SimTime>> atLoss;
+  int writesWhileOut = 0;
+  for (int i = 0; i < 3000 && findEvent(MasterEventKind::kSlaveRecovered, 0) == nullptr; ++i) {
+    run(1);
+    if (findEvent(MasterEventKind::kSlaveRecovered, 0) != nullptr) break;
+    if (findEvent(MasterEventKind::kSlaveLost, 0) == nullptr) continue;
+    const std::pair<SimTime, SimTime> now{difference(1), difference(2)};
+    if (!atLoss) atLoss = now;
+    if (now != *atLoss) ++writesWhileOut;
+  }
+  ASSERT_TRUE(atLoss) << "the master never reported the reference lost\n" << eventLog();
+  EXPECT_EQ(writesWhileOut, 0) << "cycles in which the others got a time while the reference "
+                                  "was out";
+  ASSERT_NE(findEvent(MasterEventKind::kSlaveRecovered, 0), nullptr) << eventLog();
+  EXPECT_EQ(findEvent(MasterEventKind::kRecoveryFailed, 0), nullptr) << eventLog();
+  EXPECT_EQ(esc(0).reg8(0x0981), 0x03) << "cyclic unit and SYNC0 active again";
+
+  // The reference continues the others' system time: no step for them, none for the grid.
+  EXPECT_LT(std::abs(systemTime(0) - systemTime(1)), 100);
+  run(300);
+  EXPECT_LT(std::abs(systemTime(0) - systemTime(1)), 100);
+  EXPECT_LT(std::abs(systemTime(0) - systemTime(2)), 100);
+  EXPECT_LT(difference(1), 100) << "|0x092C| of DriveB";
+  EXPECT_LT(difference(2), 100) << "|0x092C| of DriveC";
+  const std::uint64_t referenceNext = nextPulse(0);
+  const std::uint64_t otherNext = nextPulse(1);
+  EXPECT_EQ((referenceNext - setup.sync0Start) % cycle, 0u) << referenceNext;
+  const std::uint64_t t = std::max(referenceNext, otherNext) + 10 * cycle;
+  EXPECT_LT(std::abs(pulseInstant(0, t) - pulseInstant(1, t)), 100) << "SYNC0 at " << t;
   master_->resetStatistics();
   run(100);
   EXPECT_EQ(master_->statistics().wkcErrors, 0u);
