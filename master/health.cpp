@@ -108,6 +108,15 @@ void HealthMonitor::event(MasterEventKind kind, std::size_t position, std::uint6
        slaveInfos_[position].label() + " " + what + " at cycle " + std::to_string(cycle)});
 }
 
+void HealthMonitor::markRecovered(std::size_t position, std::uint64_t cycle, SimTime now) {
+  Watch& w = slaves_[position];
+  w.health.condition = SlaveCondition::kOperational;
+  ++w.health.recoveredCount;
+  ++slavesRecovered_;
+  w.lastFailure.clear();
+  event(MasterEventKind::kSlaveRecovered, position, cycle, now, "back in OP");
+}
+
 void HealthMonitor::afterCycle(const CycleResult& result, std::uint64_t cycle, SimTime now) {
   if (!recovery_) return;
   if (!result.ok()) suspicious_ = true;
@@ -124,11 +133,7 @@ void HealthMonitor::afterCycle(const CycleResult& result, std::uint64_t cycle, S
     Watch& w = slaves_[i];
     if (!w.recovery || w.recovery->step(now)) continue;
     if (w.recovery->status().ok()) {
-      w.health.condition = SlaveCondition::kOperational;
-      ++w.health.recoveredCount;
-      ++slavesRecovered_;
-      w.lastFailure.clear();
-      event(MasterEventKind::kSlaveRecovered, i, cycle, now, "back in OP");
+      markRecovered(i, cycle, now);
     } else {
       // Tried again every retryAfter cycles; reported once per reason, not at every attempt.
       w.health.condition = SlaveCondition::kFailed;
@@ -216,11 +221,7 @@ void HealthMonitor::takeStatusReads(std::uint64_t cycle, SimTime now) {
           // for another reason.
           if (cycle < w.retryAt) break;
           if (inOp) {
-            w.health.condition = SlaveCondition::kOperational;
-            ++w.health.recoveredCount;
-            ++slavesRecovered_;
-            w.lastFailure.clear();
-            event(MasterEventKind::kSlaveRecovered, i, cycle, now, "back in OP");
+            markRecovered(i, cycle, now);
           } else {
             startRecovery(i, firstStage(info), now);
           }
@@ -230,10 +231,7 @@ void HealthMonitor::takeStatusReads(std::uint64_t cycle, SimTime now) {
           event(MasterEventKind::kSlaveReturned, i, cycle, now,
                 "answers again (" + describeAlStatus(info.alStatus) + ")");
           if (inOp) {
-            w.health.condition = SlaveCondition::kOperational;
-            ++w.health.recoveredCount;
-            ++slavesRecovered_;
-            event(MasterEventKind::kSlaveRecovered, i, cycle, now, "back in OP");
+            markRecovered(i, cycle, now);
           } else {
             startRecovery(i, firstStage(info), now);
           }
@@ -313,6 +311,11 @@ void HealthMonitor::updateExpectations() {
     const std::uint32_t least = most > maybe ? most - maybe : 0u;
     cyclic_.setExpectedWkc(i, static_cast<std::uint16_t>(least), static_cast<std::uint16_t>(most));
   }
+  // A reference clock that is out may come back power-cycled, its system time started over:
+  // its time is not distributed until its recovery has given it back its offset.
+  const auto reference = setup_ ? setup_->dcReference() : std::nullopt;
+  cyclic_.holdDcDistribution(reference && *reference < slaves_.size() &&
+                             slaves_[*reference].health.condition != SlaveCondition::kOperational);
 }
 
 MasterHealth HealthMonitor::health(const TransportCounters& transport) const {

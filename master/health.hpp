@@ -136,6 +136,7 @@ class HealthMonitor {
   void takeStatusReads(std::uint64_t cycle, SimTime now);
   void takeProbes(std::uint64_t cycle, SimTime now);
   void startRecovery(std::size_t position, SlaveRecoveryTask::Stage first, SimTime now);
+  void markRecovered(std::size_t position, std::uint64_t cycle, SimTime now);
   void event(MasterEventKind kind, std::size_t position, std::uint64_t cycle, SimTime now,
              const std::string& what);
   void updateExpectations();
