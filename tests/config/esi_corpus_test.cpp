@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cctype>
-#include <chrono>
 #include <filesystem>
 #include <optional>
 #include <ostream>
@@ -68,11 +67,10 @@ class EsiCorpus : public ::testing::TestWithParam<CorpusFile> {};
 TEST_P(EsiCorpus, ParsesWithManifestCounts) {
   const CorpusFile& expected = GetParam();
   ECSIM_REQUIRE_SHARED_FILE(path, "esi", expected.file);
-  const auto start = std::chrono::steady_clock::now();
+  // How long parsing takes is measured by a benchmark, not judged here: under ASan on a busy
+  // machine the largest files took 1.5 s, which says nothing about the parser.
   auto file = loadEsiFile(path);
-  const auto elapsed = std::chrono::steady_clock::now() - start;
   ASSERT_TRUE(file.ok()) << file.error().message();
-  EXPECT_LT(elapsed, std::chrono::seconds(1)) << "parsing took too long";
   EXPECT_EQ(file->root, expected.root);
   EXPECT_EQ(file->vendor.id, expected.vendorId);
   EXPECT_EQ(file->encoding, expected.encoding);
