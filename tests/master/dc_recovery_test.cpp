@@ -50,12 +50,18 @@ TEST(DcRecoveryMathTest, OffsetMakesTheSlavesSystemTimeTheReferencesAtOnce) {
   EXPECT_EQ(big + master::recoveredDcOffset(100, 0, big, 5), std::uint64_t{105});
 }
 
-TEST(DcRecoveryMathTest, OnlySlavesSetUpForDcGetAStep) {
+// Four slaves at stations 0x1001..0x1004.
+std::vector<master::SlaveInfo> fourSlaves() {
   std::vector<master::SlaveInfo> slaves(4);
   for (std::size_t i = 0; i < slaves.size(); ++i) {
     slaves[i].position = i;
     slaves[i].station = static_cast<std::uint16_t>(0x1001 + i);
   }
+  return slaves;
+}
+
+TEST(DcRecoveryMathTest, OnlySlavesSetUpForDcGetAStep) {
+  const std::vector<master::SlaveInfo> slaves = fourSlaves();
   DcSetup setup;
   EXPECT_FALSE(master::dcRecoveryFor(setup, slaves, 2, kNsPerMs)) << "no DC set-up";
   setup.reference = 1;
@@ -83,11 +89,7 @@ TEST(DcRecoveryMathTest, OnlySlavesSetUpForDcGetAStep) {
 }
 
 TEST(DcRecoveryMathTest, TheReferenceClockTakesTheTimeFromTheNextClock) {
-  std::vector<master::SlaveInfo> slaves(4);
-  for (std::size_t i = 0; i < slaves.size(); ++i) {
-    slaves[i].position = i;
-    slaves[i].station = static_cast<std::uint16_t>(0x1001 + i);
-  }
+  const std::vector<master::SlaveInfo> slaves = fourSlaves();
   DcSetup setup;
   setup.reference = 1;
   setup.dc = {false, true, true, true};
