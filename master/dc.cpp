@@ -26,12 +26,6 @@ bool portOpen(const SlaveInfo& s, unsigned port) {
   return (s.activePorts >> port & 1u) != 0;
 }
 
-std::vector<std::uint8_t> le(std::uint64_t value, std::size_t bytes) {
-  std::vector<std::uint8_t> out(bytes);
-  for (std::size_t i = 0; i < bytes; ++i) out[i] = static_cast<std::uint8_t>(value >> (8 * i));
-  return out;
-}
-
 }  // namespace
 
 std::vector<SimTime> computeDcDelays(const std::vector<SlaveInfo>& slaves,
@@ -173,15 +167,15 @@ void DcInitTask::enter(Phase phase, SimTime now) {
     case Phase::kWrite:
       for (const auto& s : slaves_) {
         if (!setup_.dc[s.position]) continue;
-        batch_.add().fpwr(s.station, kOffset, le(setup_.offsets[s.position], 8));
+        batch_.add().fpwr(s.station, kOffset, leBytes(setup_.offsets[s.position], 8));
         batch_.add().fpwr(s.station, kDelay,
-                          le(static_cast<std::uint64_t>(setup_.delays[s.position]), 4));
+                          leBytes(static_cast<std::uint64_t>(setup_.delays[s.position]), 4));
       }
       {
         // Restart the drift filters (speed counter start 0x1000, datasheet section II).
         Datagram& reset = batch_.add();
         reset.prepare(Command::kBwr, DatagramHeader::physical(0, kSpeedCounterStart),
-                      ConstBytes(le(0x1000, 2).data(), 2), 0);
+                      ConstBytes(leBytes(0x1000, 2).data(), 2), 0);
       }
       break;
     case Phase::kDrift:
@@ -195,11 +189,11 @@ void DcInitTask::enter(Phase phase, SimTime now) {
     case Phase::kSync0:
       for (std::size_t position : setup_.sync0) {
         const std::uint16_t station = slaves_[position].station;
-        batch_.add().fpwr(station, kActivation, le(0, 1));
+        batch_.add().fpwr(station, kActivation, leBytes(0, 1));
         batch_.add().fpwr(station, kSync0CycleTime,
-                          le(static_cast<std::uint64_t>(setup_.sync0Cycle), 4));
-        batch_.add().fpwr(station, kSync0Start, le(setup_.sync0Start, 8));
-        batch_.add().fpwr(station, kAssign, le(assignActivate_[position], 2));
+                          leBytes(static_cast<std::uint64_t>(setup_.sync0Cycle), 4));
+        batch_.add().fpwr(station, kSync0Start, leBytes(setup_.sync0Start, 8));
+        batch_.add().fpwr(station, kAssign, leBytes(assignActivate_[position], 2));
       }
       break;
     case Phase::kDone:

@@ -18,15 +18,6 @@ constexpr std::uint16_t kDcLatchAndOffsetLength = static_cast<std::uint16_t>(
     reg::kSystemTimeOffset.end() - reg::kReceiveTimeEcatProcessingUnit.address);
 constexpr std::uint16_t kSpeedCounterRestart = 0x1000;  // 0x0930, as the DC set-up writes it
 
-template <typename T>
-std::vector<std::uint8_t> le(T value) {
-  std::vector<std::uint8_t> out(sizeof(T));
-  for (std::size_t i = 0; i < sizeof(T); ++i) {
-    out[i] = static_cast<std::uint8_t>(static_cast<std::uint64_t>(value) >> (8 * i));
-  }
-  return out;
-}
-
 std::string hex(unsigned v, int digits) {
   static constexpr char kDigits[] = "0123456789ABCDEF";
   std::string s = "0x";
@@ -239,7 +230,7 @@ void SlaveRecoveryTask::enter(Stage stage, SimTime now) {
       // slave's local time (0x0918) at the same point of the frame; the count of slaves that
       // latch is not checked.
       batch_.add().fpwr(slave_.station, reg::kSpeedCounterStart.address,
-                        le(kSpeedCounterRestart));
+                        leBytes(kSpeedCounterRestart, 2));
       batch_.add().prepare(Command::kBwr,
                            DatagramHeader::physical(0, reg::kReceiveTimePort0.address),
                            std::uint16_t{4}, 0);
@@ -447,19 +438,22 @@ bool SlaveRecoveryTask::stepDc(SimTime now) {
   const std::uint64_t sourceTime = sourceLocal + sourceOffset;
   batch_.clear();
   batch_.add().fpwr(slave_.station, reg::kSystemTimeDelay.address,
-                    le(static_cast<std::uint32_t>(dc.delay)));
+                    leBytes(static_cast<std::uint32_t>(dc.delay), 4));
   batch_.add().fpwr(
       slave_.station, reg::kSystemTimeOffset.address,
-      le(recoveredDcOffset(sourceLocal, sourceOffset, slaveLocal, dc.delay - dc.sourceDelay)));
-  batch_.add().fpwr(slave_.station, reg::kSpeedCounterStart.address, le(kSpeedCounterRestart));
+      leBytes(recoveredDcOffset(sourceLocal, sourceOffset, slaveLocal, dc.delay - dc.sourceDelay),
+              8));
+  batch_.add().fpwr(slave_.station, reg::kSpeedCounterStart.address,
+                    leBytes(kSpeedCounterRestart, 2));
   if (dc.sync0) {
     const std::uint64_t start = nextSync0Time(
         dc.sync0Start, dc.sync0Cycle, sourceTime + static_cast<std::uint64_t>(dc.sync0Margin));
-    batch_.add().fpwr(slave_.station, reg::kDcActivation.address, le(std::uint8_t{0}));
+    batch_.add().fpwr(slave_.station, reg::kDcActivation.address, leBytes(0, 1));
     batch_.add().fpwr(slave_.station, reg::kSync0CycleTime.address,
-                      le(static_cast<std::uint32_t>(dc.sync0Cycle)));
-    batch_.add().fpwr(slave_.station, reg::kStartTimeCyclicOperation.address, le(start));
-    batch_.add().fpwr(slave_.station, reg::kCyclicUnitControl.address, le(dc.assignActivate));
+                      leBytes(static_cast<std::uint32_t>(dc.sync0Cycle), 4));
+    batch_.add().fpwr(slave_.station, reg::kStartTimeCyclicOperation.address, leBytes(start, 8));
+    batch_.add().fpwr(slave_.station, reg::kCyclicUnitControl.address,
+                      leBytes(dc.assignActivate, 2));
   }
   batch_.queueAll(transport_);
   sub_ = Sub::kDcWrite;

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 namespace ecsim {
 
@@ -42,6 +43,13 @@ inline void writeLe32(Bytes b, std::size_t at, std::uint32_t v) {
 }
 inline void writeLe64(Bytes b, std::size_t at, std::uint64_t v) {
   for (std::size_t i = 0; i < 8; ++i) b[at + i] = static_cast<std::uint8_t>(v >> (8 * i));
+}
+// The low `count` bytes of `v`, little-endian, as a new buffer (a register write's data; not
+// for the cyclic path, it allocates).
+inline std::vector<std::uint8_t> leBytes(std::uint64_t v, std::size_t count) {
+  std::vector<std::uint8_t> out(count);
+  for (std::size_t i = 0; i < count && i < 8; ++i) out[i] = static_cast<std::uint8_t>(v >> (8 * i));
+  return out;
 }
 inline void writeBe16(Bytes b, std::size_t at, std::uint16_t v) {
   b[at] = static_cast<std::uint8_t>(v >> 8);

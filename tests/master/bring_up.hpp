@@ -9,12 +9,29 @@
 #include "config/esi.hpp"
 #include "master/batch.hpp"
 #include "master/esc_config.hpp"
+#include "master/health.hpp"
 #include "master/scan.hpp"
 #include "master/state_change.hpp"
 #include "slavesim/esi_slave.hpp"
 #include "tests/master/sim_network.hpp"
 
 namespace ecsim::testing {
+
+// The first of `events` of `kind` about the slave at `position`, or null.
+inline const master::MasterEvent* findEvent(const std::vector<master::MasterEvent>& events,
+                                            master::MasterEventKind kind, std::size_t position) {
+  for (const auto& e : events) {
+    if (e.kind == kind && e.position == position) return &e;
+  }
+  return nullptr;
+}
+
+// The events' texts, one per line (for failure messages).
+inline std::string eventLog(const std::vector<master::MasterEvent>& events) {
+  std::string s;
+  for (const auto& e : events) s += e.text + "\n";
+  return s;
+}
 
 inline Status scanAndPreOp(SimNetwork& net, master::Transport& transport,
                            std::vector<master::SlaveInfo>& slaves) {

@@ -152,11 +152,7 @@ class CycleAllocTest : public ::testing::Test {
     while (bus_.now() < next) bus_.wait(next);
     start_ = bus_.now();
   }
-  std::string eventLog() const {
-    std::string s;
-    for (const auto& e : master_->events()) s += e.text + "\n";
-    return s;
-  }
+  std::string eventLog() const { return testing::eventLog(master_->events()); }
 
   VirtualNetwork net_;
   master::Bus& bus_{net_.bus()};

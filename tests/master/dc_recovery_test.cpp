@@ -145,16 +145,9 @@ class DcRecoveryTest : public ::testing::Test {
     }
   }
   const master::MasterEvent* findEvent(MasterEventKind kind, std::size_t position) const {
-    for (const auto& e : master_->events()) {
-      if (e.kind == kind && e.position == position) return &e;
-    }
-    return nullptr;
+    return testing::findEvent(master_->events(), kind, position);
   }
-  std::string eventLog() const {
-    std::string s;
-    for (const auto& e : master_->events()) s += e.text + "\n";
-    return s;
-  }
+  std::string eventLog() const { return testing::eventLog(master_->events()); }
   slavesim::Esc& esc(std::size_t i) { return net_.segment().slave(i).esc(); }
   // |0x092C| as the ESC last computed it (sign-magnitude).
   SimTime difference(std::size_t i) { return esc(i).reg32(0x092C) & 0x7FFFFFFF; }

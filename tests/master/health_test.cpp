@@ -159,16 +159,9 @@ class RecoveryTest : public ::testing::Test {
     return limit + 1;
   }
   const master::MasterEvent* findEvent(MasterEventKind kind, std::size_t position) const {
-    for (const auto& e : master_->events()) {
-      if (e.kind == kind && e.position == position) return &e;
-    }
-    return nullptr;
+    return testing::findEvent(master_->events(), kind, position);
   }
-  std::string eventLog() const {
-    std::string s;
-    for (const auto& e : master_->events()) s += e.text + "\n";
-    return s;
-  }
+  std::string eventLog() const { return testing::eventLog(master_->events()); }
   slavesim::Slave& sim(std::size_t i) { return net_.segment().slave(i); }
 
   SimNetwork net_;
@@ -430,8 +423,7 @@ TEST(EniRecoveryTest, PowerCycledSlaveGetsItsEniInitCommandsAgain) {
     while (net.clock().now() < next) net.bus().wait(next);
     back = master.health().allOperational() && aiSim.state() == AlState::kOp;
   }
-  std::string log;
-  for (const auto& e : master.events()) log += e.text + "\n";
+  const std::string log = eventLog(master.events());
   ASSERT_TRUE(back) << log;
   EXPECT_EQ(aiSim.esc().reg16(kWatchdogTime), 500) << log;
   EXPECT_EQ(mailbox.downloads, (std::vector<std::pair<std::uint16_t, std::uint8_t>>{{0x8000, 1}}))

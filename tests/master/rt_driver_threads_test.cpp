@@ -64,15 +64,9 @@ class RtDriverThreadsTest : public ::testing::Test {
     return done(driver.snapshot());
   }
   static bool hasEvent(const master::RtSnapshot& s, MasterEventKind kind, std::size_t position) {
-    return std::any_of(s.events.begin(), s.events.end(), [&](const master::MasterEvent& e) {
-      return e.kind == kind && e.position == position;
-    });
+    return testing::findEvent(s.events, kind, position) != nullptr;
   }
-  static std::string eventLog(const master::RtSnapshot& s) {
-    std::string log;
-    for (const auto& e : s.events) log += e.text + "\n";
-    return log;
-  }
+  static std::string eventLog(const master::RtSnapshot& s) { return testing::eventLog(s.events); }
   AlState simState(std::size_t i) {
     AlState state = AlState::kInit;
     net_.onServer([&](topology::Segment& segment) { state = segment.slave(i).state(); });
