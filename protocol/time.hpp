@@ -3,7 +3,9 @@
 #pragma once
 
 #include <chrono>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 
 namespace ecsim {
 
@@ -16,6 +18,34 @@ constexpr SimTime kNsPerSecond = 1'000'000'000;
 // Nanoseconds between the Unix epoch and 2000-01-01T00:00:00Z, the EtherCAT DC epoch
 // (ESC datasheet section I, §9.1: "system time starts 1 Jan 2000 00:00, unit 1 ns").
 constexpr std::int64_t kDcEpochUnixNs = 946'684'800LL * kNsPerSecond;
+
+constexpr SimTime kSimTimeMax = std::numeric_limits<SimTime>::max();
+constexpr SimTime kSimTimeMin = std::numeric_limits<SimTime>::min();
+
+// Saturating arithmetic for times that input controls (delay spikes, durations, scenario
+// times, paced return times): a sum or product beyond the range of SimTime sticks at its end
+// (about 292 years either side of 0) instead of wrapping, so "late" stays late.
+constexpr SimTime saturatingAdd(SimTime a, SimTime b) {
+  SimTime sum = 0;
+  if (__builtin_add_overflow(a, b, &sum)) return b > 0 ? kSimTimeMax : kSimTimeMin;
+  return sum;
+}
+constexpr SimTime saturatingMul(SimTime a, SimTime b) {
+  SimTime product = 0;
+  if (__builtin_mul_overflow(a, b, &product)) {
+    return (a < 0) == (b < 0) ? kSimTimeMax : kSimTimeMin;
+  }
+  return product;
+}
+// A count of nanoseconds given as a double, rounded to the nearest and clamped to SimTime's
+// range; NaN gives 0 (callers reject NaN where it is read: this only keeps the cast defined).
+inline SimTime saturatingTime(double ns) {
+  if (std::isnan(ns)) return 0;
+  // 2^63 is exactly representable; anything at or above it does not fit.
+  if (ns >= 0x1.0p63) return kSimTimeMax;
+  if (ns <= -0x1.0p63) return kSimTimeMin;
+  return static_cast<SimTime>(std::llround(ns));
+}
 
 class Clock {
  public:
