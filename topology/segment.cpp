@@ -1,5 +1,6 @@
 #include "topology/segment.hpp"
 
+#include <algorithm>
 #include <string>
 
 namespace ecsim::topology {
@@ -269,7 +270,7 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
 }
 
 bool Segment::arriveWithFaults(std::size_t s, unsigned port, SimTime& t, bool& bad) {
-  t += faults_->extraDelay(s, port, t);
+  t = saturatingAdd(t, std::clamp<SimTime>(faults_->extraDelay(s, port, t), 0, kMaxWireExtraDelay));
   auto& esc = slaves_[s]->esc();
   if (bad) {
     // An ESC forwarding a frame with a bad FCS marks it; the next ESCs count a forwarded

@@ -55,9 +55,12 @@ class WireFaults {
  public:
   virtual ~WireFaults() = default;
   virtual bool corrupts(std::size_t slave, unsigned port, SimTime time) = 0;
-  // Extra time the cable ending at (slave, port) takes now (delay spikes).
+  // Extra time the cable ending at (slave, port) takes now (delay spikes). The segment takes
+  // at most kMaxWireExtraDelay of it per crossing (and nothing below 0), so a frame's times
+  // stay far inside SimTime's range whatever an implementation returns.
   virtual SimTime extraDelay(std::size_t slave, unsigned port, SimTime time) = 0;
 };
+constexpr SimTime kMaxWireExtraDelay = 3600 * kNsPerSecond;
 
 struct FrameOutcome {
   bool delivered{false};  // false: dropped (malformed or lost)

@@ -62,6 +62,13 @@ inline void buildLine(topology::Segment& seg, std::size_t n) {
   seg.wireLine();
 }
 
+// Wire faults that only delay: every cable crossing takes `extra` longer.
+struct FixedWireDelay : topology::WireFaults {
+  SimTime extra{0};
+  bool corrupts(std::size_t, unsigned, SimTime) override { return false; }
+  SimTime extraDelay(std::size_t, unsigned, SimTime) override { return extra; }
+};
+
 struct DatagramSpec {
   Command command;
   std::uint32_t address;

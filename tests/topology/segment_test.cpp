@@ -87,6 +87,30 @@ TEST(Segment, ReturnTimeFollowsTheWireModel) {
       << "last bit arrives one frame wire time after the first";
 }
 
+// Issue #21: a wire fault's extra delay near the end of SimTime overflowed `t + extra`.
+TEST(Segment, ExtraWireDelayIsBoundedAndNeverWraps) {
+  topology::Segment seg;
+  buildLine(seg, 3);
+  std::array<std::uint8_t, kMaxFrameSize> buf{};
+  FrameBuilder b(buf, EthernetHeader{});
+  ASSERT_TRUE(b.add(Command::kBrd, 0, 0, 2).ok());
+  auto len = b.finish();
+  const SimTime plain = seg.processFrame(std::span(buf.data(), *len), 0).firstBitRoundTrip;
+  FixedWireDelay faults;
+  seg.setWireFaults(&faults);
+  for (SimTime extra : {kSimTimeMax, kSimTimeMin, SimTime{-5}}) {
+    faults.extra = extra;
+    const SimTime send = 1'000'000;
+    auto out = seg.processFrame(std::span(buf.data(), *len), send);
+    // Five cable arrivals in a line of 3 (three down, two back up), each delayed by at most
+    // the bound; a negative extra delay is none.
+    const SimTime expected = extra > 0 ? plain + 5 * topology::kMaxWireExtraDelay : plain;
+    EXPECT_EQ(out.firstBitRoundTrip, expected) << extra;
+    EXPECT_GT(out.returnTime, send) << extra;
+  }
+  seg.setWireFaults(nullptr);
+}
+
 TEST(Segment, DcLatchMeasuresTheDownstreamRoundTrip) {
   topology::Segment seg;
   buildLine(seg, 3);
