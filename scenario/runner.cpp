@@ -459,13 +459,14 @@ ScenarioResult Run::execute() {
         applied[i] = true;
         std::string what;
         if (a.action.verb == "pause-master") {
-          auto d = a.action.real("durationMs");
+          auto d = a.action.millis("durationMs");
           if (!d.ok()) {
             r_.error = d.error().context;
             return r_;
           }
-          pausedUntil = clock_.now() + static_cast<SimTime>(*d * kNsPerMs + 0.5);
-          what = fmt::format("the master sends nothing for {} ms", number(*d));
+          pausedUntil = saturatingAdd(clock_.now(), *d);
+          what = fmt::format("the master sends nothing for {} ms",
+                             number(static_cast<double>(*d) / kNsPerMs));
         } else {
           auto done = faults.apply(a.action, clock_.now());
           if (!done.ok()) {

@@ -105,11 +105,8 @@ FaultyMailbox& faultyMailbox(slavesim::Slave& slave) {
 // frame or power, on=0 clears, channel=N (default 1).
 Result<std::string> encoderFault(const FaultAction& a, slavesim::Slave& slave) {
   auto& encoder = *slavesim::devices::encoderTerminalOf(slave);
-  ECSIM_ASSIGN_OR_RETURN(auto channel, a.number("channel", 1));
-  if (channel < 1 || channel > encoder.channels()) {
-    return a.error(fmt::format("{} has channels 1..{}", slave.name(), encoder.channels()));
-  }
-  ECSIM_ASSIGN_OR_RETURN(auto on, a.number("on", 1));
+  ECSIM_ASSIGN_OR_RETURN(auto channel, a.number("channel", 1, encoder.channels(), 1));
+  ECSIM_ASSIGN_OR_RETURN(auto on, a.number("on", 0, 1, 1));
   namespace ef = slavesim::devices::encoder_fault;
   const std::string_view kind = a.get("kind").value_or("data");
   std::uint8_t bit = ef::kData;
@@ -160,25 +157,36 @@ Result<std::string_view> FaultAction::require(std::string_view key) const {
   return error("missing argument '" + std::string(key) + "'");
 }
 
-Result<std::uint64_t> FaultAction::number(std::string_view key) const {
+Result<std::uint64_t> FaultAction::number(std::string_view key, std::uint64_t lo,
+                                          std::uint64_t hi) const {
   ECSIM_ASSIGN_OR_RETURN(auto text, require(key));
-  if (auto v = parseNumber(text)) return *v;
-  return error("argument " + std::string(key) + "='" + std::string(text) + "' is not a number");
+  auto v = parseNumber(text);
+  if (v && *v >= lo && *v <= hi) return *v;
+  const bool hex = text.size() > 1 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X');
+  const auto bound = [hex](std::uint64_t b) {
+    return hex && b != 0 ? fmt::format("{:#x}", b) : fmt::format("{}", b);
+  };
+  return error(fmt::format("{}={} is not a number in [{}, {}]", key, text, bound(lo), bound(hi)));
 }
 
-Result<std::uint64_t> FaultAction::number(std::string_view key, std::uint64_t fallback) const {
+Result<std::uint64_t> FaultAction::number(std::string_view key, std::uint64_t lo, std::uint64_t hi,
+                                          std::uint64_t fallback) const {
   if (!get(key)) return fallback;
-  return number(key);
+  return number(key, lo, hi);
 }
 
-Result<double> FaultAction::real(std::string_view key) const {
+Result<double> FaultAction::real(std::string_view key, double lo, double hi) const {
   ECSIM_ASSIGN_OR_RETURN(auto text, require(key));
   double v = 0;
   auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-  if (ec != std::errc() || end != text.data() + text.size()) {
-    return error("argument " + std::string(key) + "='" + std::string(text) + "' is not a number");
-  }
-  return v;
+  // NaN fails both comparisons: written so that it is refused.
+  if (ec == std::errc() && end == text.data() + text.size() && v >= lo && v <= hi) return v;
+  return error(fmt::format("{}={} is not a number in [{}, {}]", key, text, lo, hi));
+}
+
+Result<SimTime> FaultAction::millis(std::string_view key) const {
+  ECSIM_ASSIGN_OR_RETURN(auto ms, real(key, 0, static_cast<double>(kMaxFaultDurationMs)));
+  return saturatingTime(ms * static_cast<double>(kNsPerMs));
 }
 
 std::string FaultAction::text() const {
@@ -269,8 +277,7 @@ Result<FaultInjector::End> FaultInjector::cableEnd(const FaultAction& action) co
   if (auto slave = action.get("slave")) {
     auto s = slaveIndex(*slave);
     if (!s.ok()) return action.error(s.error().context);
-    ECSIM_ASSIGN_OR_RETURN(auto port, action.number("port"));
-    if (port >= kPortCount) return action.error("port must be 0..3");
+    ECSIM_ASSIGN_OR_RETURN(auto port, action.number("port", 0, kPortCount - 1));
     return End{*s, static_cast<unsigned>(port)};
   }
   return action.error("needs cable=NAME or slave=NAME port=N");
@@ -304,7 +311,7 @@ SimTime FaultInjector::extraDelay(std::size_t slave, unsigned port, SimTime time
     if (time >= s.until) continue;
     if ((s.end.slave == slave && s.end.port == port) ||
         (peer(s.end) && peer(s.end)->slave == slave && peer(s.end)->port == port)) {
-      extra += s.extra;
+      extra = saturatingAdd(extra, s.extra);
     }
   }
   return extra;
@@ -356,8 +363,7 @@ Result<std::string> FaultInjector::powerOn(std::size_t s, SimTime now) {
 Result<std::string> FaultInjector::apply(const FaultAction& a, SimTime now) {
   const std::string& v = a.verb;
   if (v == "loss") {
-    ECSIM_ASSIGN_OR_RETURN(auto rate, a.real("rate"));
-    if (rate < 0 || rate > 1) return a.error("rate must be within 0..1");
+    ECSIM_ASSIGN_OR_RETURN(auto rate, a.real("rate", 0, 1));
     End end{0, 0};
     if (a.get("cable")) {
       ECSIM_ASSIGN_OR_RETURN(end, cableEnd(a));
@@ -371,23 +377,43 @@ Result<std::string> FaultInjector::apply(const FaultAction& a, SimTime now) {
   }
   if (v == "corrupt") {
     ECSIM_ASSIGN_OR_RETURN(auto end, cableEnd(a));
-    ECSIM_ASSIGN_OR_RETURN(auto count, a.number("count", 1));
-    if (count > 0) corruptCount_[end] += count;
+    ECSIM_ASSIGN_OR_RETURN(auto count, a.number("count", 0, kMaxCorruptCount, 1));
+    if (count == 0) {
+      corruptCount_.erase(end);
+      refreshAny();
+      return fmt::format("corruption entering {} port {} cleared", segment_.slave(end.slave).name(),
+                         end.port);
+    }
+    auto& pending = corruptCount_[end];
+    pending = std::min(pending + count, kMaxCorruptCount);
     refreshAny();
-    return fmt::format("{} frame(s) corrupted entering {} port {}", count,
+    return fmt::format("{} frame(s) corrupted entering {} port {}", pending,
                        segment_.slave(end.slave).name(), end.port);
   }
   if (v == "delay") {
     ECSIM_ASSIGN_OR_RETURN(auto end, cableEnd(a));
-    ECSIM_ASSIGN_OR_RETURN(auto ns, a.number("ns"));
-    ECSIM_ASSIGN_OR_RETURN(auto ms, a.real("durationMs"));
-    spikes_.erase(std::remove_if(spikes_.begin(), spikes_.end(),
-                                 [&](const Spike& s) { return s.until <= now; }),
-                  spikes_.end());
-    spikes_.push_back(
-        {end, static_cast<SimTime>(ns), now + static_cast<SimTime>(ms * kNsPerMs + 0.5)});
+    ECSIM_ASSIGN_OR_RETURN(auto ns, a.number("ns", 0, kMaxDelaySpikeNs));
+    ECSIM_ASSIGN_OR_RETURN(auto duration, a.millis("durationMs"));
+    const std::optional<End> other = peer(end);
+    const auto sameCable = [&](const Spike& s) {
+      return s.end == end || (other && s.end == *other);
+    };
+    spikes_.erase(
+        std::remove_if(spikes_.begin(), spikes_.end(),
+                       [&](const Spike& s) { return s.until <= now || (ns == 0 && sameCable(s)); }),
+        spikes_.end());
     refreshAny();
-    return fmt::format("cable delay +{} ns for {} ms", ns, ms);
+    if (ns == 0) return std::string("delay spikes on the cable removed");
+    if (duration == 0) return std::string("no delay: durationMs=0");
+    if (spikes_.size() >= kMaxDelaySpikes) {
+      return a.error(
+          fmt::format("{} delay spikes are active, the most at once (ns=0 removes a "
+                      "cable's spikes)",
+                      spikes_.size()));
+    }
+    spikes_.push_back({end, static_cast<SimTime>(ns), saturatingAdd(now, duration)});
+    refreshAny();
+    return fmt::format("cable delay +{} ns for {} ms", ns, a.get("durationMs").value_or(""));
   }
   if (v == "link-down" || v == "link-up") {
     ECSIM_ASSIGN_OR_RETURN(auto end, cableEnd(a));
@@ -406,19 +432,26 @@ Result<std::string> FaultInjector::apply(const FaultAction& a, SimTime now) {
     ECSIM_ASSIGN_OR_RETURN(auto name, a.require("slave"));
     auto s = slaveIndex(name);
     if (!s.ok()) return a.error(s.error().context);
-    ECSIM_ASSIGN_OR_RETURN(auto channel, a.number("channel"));
     ECSIM_ASSIGN_OR_RETURN(auto text, a.require("signal"));
     auto signal = slavesim::devices::parseSignal(text);
     if (!signal.ok()) return a.error(signal.error().context);
     auto& slave = segment_.slave(*s);
-    if (auto* di = slavesim::devices::digitalInputsOf(slave)) {
-      di->setScript(static_cast<unsigned>(channel), *signal);
-    } else if (auto* ai = slavesim::devices::analogInputsOf(slave)) {
-      ai->setScript(static_cast<unsigned>(channel), *signal);
-    } else if (auto* enc = slavesim::devices::encoderTerminalOf(slave)) {
-      enc->setScript(static_cast<unsigned>(channel), *signal);  // shaft position in turns
+    auto* di = slavesim::devices::digitalInputsOf(slave);
+    auto* ai = slavesim::devices::analogInputsOf(slave);
+    auto* enc = slavesim::devices::encoderTerminalOf(slave);
+    const unsigned channels = di != nullptr    ? di->channels()
+                              : ai != nullptr  ? ai->channels()
+                              : enc != nullptr ? enc->channels()
+                                               : 0;
+    if (channels == 0) return a.error(slave.name() + " has no scriptable inputs");
+    ECSIM_ASSIGN_OR_RETURN(auto ch, a.number("channel", 1, channels));
+    const auto channel = static_cast<unsigned>(ch);
+    if (di != nullptr) {
+      di->setScript(channel, *signal);
+    } else if (ai != nullptr) {
+      ai->setScript(channel, *signal);
     } else {
-      return a.error(slave.name() + " has no scriptable inputs");
+      enc->setScript(channel, *signal);  // shaft position in turns
     }
     return fmt::format("{} input {} = {}", slave.name(), channel, text);
   }
@@ -435,7 +468,7 @@ Result<std::string> FaultInjector::apply(const FaultAction& a, SimTime now) {
     return powerOn(s, now);
   }
   if (v == "al-error") {
-    ECSIM_ASSIGN_OR_RETURN(auto code, a.number("code"));
+    ECSIM_ASSIGN_OR_RETURN(auto code, a.number("code", 0, 0xFFFF));
     AlState target = std::min(slave.state(), AlState::kSafeOp);
     if (auto st = a.get("state")) {
       auto parsed = stateFromName(*st);
@@ -455,27 +488,38 @@ Result<std::string> FaultInjector::apply(const FaultAction& a, SimTime now) {
     return powerOn(s, now);
   }
   if (v == "mailbox-silent" || v == "mailbox-ok") {
+    ECSIM_ASSIGN_OR_RETURN(auto on, a.number("on", 0, 1, v == "mailbox-silent" ? 1 : 0));
     if (slave.mailboxServer() == nullptr) return a.error(slave.name() + " has no mailbox");
-    ECSIM_ASSIGN_OR_RETURN(auto on, a.number("on", v == "mailbox-silent" ? 1 : 0));
     faultyMailbox(slave).silent = on != 0;
     return fmt::format("{}: mailbox {}", slave.name(), on != 0 ? "silent" : "answering");
   }
   if (v == "sdo-abort" || v == "sdo-ok") {
+    FaultyMailbox::Rule rule;
+    if (v == "sdo-abort") {
+      ECSIM_ASSIGN_OR_RETURN(auto objIndex, a.number("index", 0, 0xFFFF));
+      // Default: object does not exist.
+      ECSIM_ASSIGN_OR_RETURN(auto code, a.number("code", 0, 0xFFFFFFFF, 0x06020000));
+      rule.index = static_cast<std::uint16_t>(objIndex);
+      rule.code = static_cast<std::uint32_t>(code);
+      if (a.get("sub")) {
+        ECSIM_ASSIGN_OR_RETURN(auto sub, a.number("sub", 0, 0xFF));
+        rule.subindex = static_cast<std::uint8_t>(sub);
+      }
+    }
     if (slave.mailboxServer() == nullptr) return a.error(slave.name() + " has no mailbox");
     auto& mbx = faultyMailbox(slave);
     if (v == "sdo-ok") {
       mbx.aborts.clear();
       return slave.name() + ": SDO aborts removed";
     }
-    ECSIM_ASSIGN_OR_RETURN(auto objIndex, a.number("index"));
-    ECSIM_ASSIGN_OR_RETURN(auto code, a.number("code", 0x06020000));  // object does not exist
-    FaultyMailbox::Rule rule{static_cast<std::uint16_t>(objIndex), std::nullopt,
-                             static_cast<std::uint32_t>(code)};
-    if (a.get("sub")) {
-      ECSIM_ASSIGN_OR_RETURN(auto sub, a.number("sub"));
-      rule.subindex = static_cast<std::uint8_t>(sub);
-    }
+    // One rule per object: a new code replaces the old (the list stays as long as the
+    // objects named, at most 65,536 x 257).
+    std::erase_if(mbx.aborts, [&](const FaultyMailbox::Rule& r) {
+      return r.index == rule.index && r.subindex == rule.subindex;
+    });
     mbx.aborts.push_back(rule);
+    const auto objIndex = rule.index;
+    const auto code = rule.code;
     return fmt::format("{}: SDO {:#06x} aborted with {:#010x} ({})", slave.name(), objIndex, code,
                        sdoAbortText(static_cast<std::uint32_t>(code)));
   }
@@ -483,16 +527,16 @@ Result<std::string> FaultInjector::apply(const FaultAction& a, SimTime now) {
     if (slavesim::devices::encoderTerminalOf(slave) != nullptr) return encoderFault(a, slave);
   }
   if (v == "drive-fault" || v == "encoder-fault") {
+    std::uint16_t code = kPositionSensorFault;
+    if (v == "drive-fault") {
+      ECSIM_ASSIGN_OR_RETURN(auto c, a.number("code", 0, 0xFFFF, kOvercurrent));
+      code = static_cast<std::uint16_t>(c);
+    }
     auto* drive = slavesim::devices::driveOf(slave);
     if (drive == nullptr) {
       return a.error(slave.name() + (v == "encoder-fault"
                                          ? " is neither an encoder terminal nor a CiA 402 drive"
                                          : " is not a CiA 402 drive"));
-    }
-    std::uint16_t code = kPositionSensorFault;
-    if (v == "drive-fault") {
-      ECSIM_ASSIGN_OR_RETURN(auto c, a.number("code", kOvercurrent));
-      code = static_cast<std::uint16_t>(c);
     }
     drive->injectFault(code);
     return fmt::format("{}: drive fault {:#06x}", slave.name(), code);

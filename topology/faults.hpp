@@ -23,6 +23,17 @@
 //   input slave=S channel=N signal=TEXT    scripted input (slavesim/devices/signal.hpp); on an
 //                                   encoder terminal the shaft position in turns
 //
+// Numbers: every argument has a range and a value outside it is refused with the range in the
+// message ("loss: rate=nan is not a number in [0, 1]"); NaN, infinities and integers that do
+// not fit are refused, never truncated. rate in [0, 1]; ns in [0, kMaxDelaySpikeNs] (1 s);
+// durationMs in [0, kMaxFaultDurationMs] (one day); count in [0, kMaxCorruptCount]; codes
+// and indexes within their wire width (al-error/drive-fault code and sdo-abort index 16 bits,
+// sdo-abort code 32 bits, sub 8 bits); port 0..3; on 0..1; channel 1..the device's channels.
+// Clearing: a fault's zero removes it. "loss rate=0" ends the loss, "corrupt count=0" drops
+// the corruptions still pending at that cable, "delay ns=0" removes the cable's delay spikes;
+// the others have their opposite verb or on=0 (link-up, power-on, mailbox-ok, sdo-ok,
+// encoder-fault on=0). At most kMaxDelaySpikes spikes are active at once.
+//
 // Random decisions come from a SplitMix64 generator seeded by the caller: the same seed and the
 // same frames give the same faults.
 #pragma once
@@ -60,6 +71,11 @@ class SplitMix64 {
   std::uint64_t state_;
 };
 
+constexpr std::uint64_t kMaxDelaySpikeNs = 1'000'000'000;  // 1 s per spike, each way
+constexpr std::uint64_t kMaxFaultDurationMs = 86'400'000;  // one day
+constexpr std::uint64_t kMaxCorruptCount = 1'000'000;      // pending, per cable end
+constexpr std::size_t kMaxDelaySpikes = 64;                // active at once
+
 struct FaultAction {
   std::string verb;
   std::map<std::string, std::string, std::less<>> args;
@@ -67,9 +83,16 @@ struct FaultAction {
 
   std::optional<std::string_view> get(std::string_view key) const;
   Result<std::string_view> require(std::string_view key) const;
-  Result<std::uint64_t> number(std::string_view key) const;  // decimal or 0x hex
-  Result<std::uint64_t> number(std::string_view key, std::uint64_t fallback) const;
-  Result<double> real(std::string_view key) const;
+  // An integer argument (decimal or 0x hex) in [lo, hi]; the error names the range (in hex
+  // when the value was written in hex).
+  Result<std::uint64_t> number(std::string_view key, std::uint64_t lo, std::uint64_t hi) const;
+  // The same, `fallback` when the argument is absent.
+  Result<std::uint64_t> number(std::string_view key, std::uint64_t lo, std::uint64_t hi,
+                               std::uint64_t fallback) const;
+  // A finite real argument in [lo, hi].
+  Result<double> real(std::string_view key, double lo, double hi) const;
+  // A duration in milliseconds (real, [0, kMaxFaultDurationMs]) as nanoseconds.
+  Result<SimTime> millis(std::string_view key) const;
   Error error(std::string_view message) const;
   // "link-down cable=drives" (arguments in key order).
   std::string text() const;

@@ -158,5 +158,83 @@ TEST(FaultAction, ParsesQuotedValuesAndRoundTrips) {
   EXPECT_FALSE(parseFaultAction("input signal=\"open").ok());
 }
 
+// Issue #21: every argument has a range, the error names it; NaN, infinities and integers that
+// do not fit are refused, never truncated or wrapped.
+TEST(FaultArguments, OutOfRangeNumbersAreRefusedWithTheRange) {
+  Network net = makeLine(2);
+  FaultInjector faults(net, 1);
+  struct Case {
+    const char* line;
+    const char* expected;  // in the error
+  };
+  const Case cases[] = {
+      {"loss rate=nan", "rate=nan is not a number in [0, 1]"},
+      {"loss rate=inf", "[0, 1]"},
+      {"loss rate=-0.5", "[0, 1]"},
+      {"loss rate=1.5", "[0, 1]"},
+      {"delay cable=master ns=9223372036854775807 durationMs=10", "ns=9223372036854775807"},
+      {"delay cable=master ns=18446744073709551615 durationMs=10", "[0, 1000000000]"},
+      {"delay cable=master ns=99999999999999999999999 durationMs=10", "[0, 1000000000]"},
+      {"delay cable=master ns=-1 durationMs=10", "[0, 1000000000]"},
+      {"delay cable=master ns=100 durationMs=1e300", "durationMs=1e300"},
+      {"delay cable=master ns=100 durationMs=nan", "[0, 86400000]"},
+      {"delay cable=master ns=100 durationMs=-5", "[0, 86400000]"},
+      {"corrupt cable=master count=18446744073709551615", "[0, 1000000]"},
+      {"al-error slave=S0 code=0x1FFFFFFFFFF", "code=0x1FFFFFFFFFF is not a number in [0, 0xffff]"},
+      {"drive-fault slave=S0 code=0x10000", "[0, 0xffff]"},
+      {"sdo-abort slave=S0 index=0x10000", "[0, 0xffff]"},
+      {"sdo-abort slave=S0 index=0x6040 sub=256", "[0, 255]"},
+      {"sdo-abort slave=S0 index=0x6040 code=0x100000000", "[0, 0xffffffff]"},
+      {"mailbox-silent slave=S0 on=2", "[0, 1]"},
+      {"link-down slave=S0 port=4294967296", "[0, 3]"},
+  };
+  for (const Case& c : cases) {
+    auto r = faults.apply(action(c.line), 0);
+    ASSERT_FALSE(r.ok()) << c.line << " was accepted: " << *r;
+    EXPECT_NE(r.error().context.find(c.expected), std::string::npos)
+        << c.line << ": " << r.error().context;
+  }
+}
+
+TEST(FaultArguments, ZeroClearsTheFault) {
+  Network net = makeLine(3);
+  FaultInjector faults(net, 1);
+  SimTime now = 0;
+  auto send = [&] {  // a frame 100 us after the last: its outcome, times relative to its send
+    auto frame = brdFrame();
+    now += 100000;
+    auto out = net.segment->processFrame(frame, now);
+    out.returnTime -= now;
+    return out;
+  };
+  auto apply = [&](const char* line) { return faults.apply(action(line), now).ok(); };
+  const SimTime plain = send().returnTime;
+  ASSERT_TRUE(apply("corrupt cable=c1 count=1000"));
+  EXPECT_FALSE(send().delivered);
+  ASSERT_TRUE(apply("corrupt cable=c1 count=0"));
+  EXPECT_TRUE(send().delivered) << "corrupt count=0 clears";
+
+  ASSERT_TRUE(apply("delay cable=c2 ns=5000 durationMs=1000"));
+  ASSERT_TRUE(apply("delay cable=c2 ns=7000 durationMs=1000"));
+  EXPECT_EQ(send().returnTime, plain + 24000) << "both spikes, both ways";
+  ASSERT_TRUE(apply("delay cable=c2 ns=0 durationMs=0"));
+  EXPECT_EQ(send().returnTime, plain) << "delay ns=0 removes the cable's spikes";
+
+  ASSERT_TRUE(apply("loss rate=1 cable=c1"));
+  EXPECT_FALSE(send().delivered);
+  ASSERT_TRUE(apply("loss rate=0 cable=c1"));
+  EXPECT_TRUE(send().delivered);
+}
+
+TEST(FaultArguments, CorruptCountsAddUpToTheBoundNotBeyond) {
+  Network net = makeLine(2);
+  FaultInjector faults(net, 1);
+  ASSERT_TRUE(faults.apply(action("corrupt cable=c1 count=1000000"), 0).ok());
+  ASSERT_TRUE(faults.apply(action("corrupt cable=c1 count=1000000"), 0).ok());
+  ASSERT_TRUE(faults.apply(action("corrupt cable=c1 count=0"), 0).ok());
+  auto frame = brdFrame();
+  EXPECT_TRUE(net.segment->processFrame(frame, 0).delivered);
+}
+
 }  // namespace
 }  // namespace ecsim::topology
