@@ -1,12 +1,39 @@
 #include "topology/network_server.hpp"
 
+#include <algorithm>
+#include <thread>
+
 namespace ecsim::topology {
+namespace {
+
+// A paced wait sleeps in slices of at most this (looking at the stop callback after each)
+// until kPacedSpin is left, which it spins so that the answer leaves on time.
+constexpr SimTime kPacedSlice = kNsPerMs;
+constexpr SimTime kPacedSpin = 200 * kNsPerUs;
+
+}  // namespace
 
 NetworkServer::NetworkServer(Link& link, Segment& segment, const Clock& clock,
                              ServerOptions options)
     : link_(link), segment_(segment), clock_(clock), options_(options) {}
 
 Status NetworkServer::step() {
+  return step(std::function<bool()>());
+}
+
+bool NetworkServer::waitUntil(SimTime t, const std::function<bool()>& stop) {
+  while (true) {
+    const SimTime left = t - clock_.now();
+    if (left <= 0) return true;
+    if (left > kPacedSpin) {
+      std::this_thread::sleep_for(
+          std::chrono::nanoseconds(std::min(left - kPacedSpin, kPacedSlice)));
+      if (stop && stop()) return false;
+    }
+  }
+}
+
+Status NetworkServer::step(const std::function<bool()>& stop) {
   auto received = link_.receive(buffer_, options_.idleWait);
   const SimTime now = clock_.now();
   if (!received.ok()) {
@@ -27,9 +54,12 @@ Status NetworkServer::step() {
   }
   counters_.lastRoundTrip = outcome.returnTime - now;
   if (options_.paced) {
-    while (clock_.now() < outcome.returnTime) {
-      // Round trips are microseconds: waiting actively keeps the answer on time.
+    if (outcome.returnTime - now > options_.maxPacedWait.count()) {
+      ++counters_.framesLate;
+      segment_.pollSlaves(now);
+      return okStatus();
     }
+    if (!waitUntil(outcome.returnTime, stop)) return okStatus();
   }
   if (auto sent = link_.send(frame); !sent.ok()) {
     ++counters_.sendErrors;
@@ -43,7 +73,7 @@ Status NetworkServer::step() {
 
 Status NetworkServer::run(const std::function<bool()>& stop) {
   while (!stop()) {
-    ECSIM_TRY(step());
+    ECSIM_TRY(step(stop));
   }
   return okStatus();
 }

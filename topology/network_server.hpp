@@ -2,6 +2,11 @@
 // simulated network and sent back, processed, on the same link. Malformed frames are dropped
 // and counted, never answered. In paced mode a frame goes back only when its modelled return
 // time has come on the injected clock, so an external master sees realistic round trips.
+// A paced wait is bounded: a frame whose modelled return lies more than maxPacedWait after it
+// arrived (a delay spike, docs/scenarios.md) is not answered and counted as late, as a real
+// master sees such a frame: lost, its timeout long past. While an answer is held, run()'s stop
+// callback is consulted at least every millisecond (the serve loop's signal flag and control
+// socket), and a raised stop ends the wait without answering.
 #pragma once
 
 #include <array>
@@ -20,12 +25,15 @@ struct ServerOptions {
   bool paced{false};
   // How long one step waits for a frame before running the slaves' firmware anyway.
   std::chrono::nanoseconds idleWait{std::chrono::milliseconds(1)};
+  // Paced mode: the longest an answer is held.
+  std::chrono::nanoseconds maxPacedWait{std::chrono::seconds(1)};
 };
 
 struct ServerCounters {
   std::uint64_t framesReceived{0};
   std::uint64_t framesAnswered{0};
   std::uint64_t framesDropped{0};  // malformed: not answered
+  std::uint64_t framesLate{0};     // paced: modelled return beyond maxPacedWait, not answered
   std::uint64_t receiveErrors{0};
   std::uint64_t sendErrors{0};
   SimTime lastRoundTrip{0};
@@ -37,7 +45,7 @@ class NetworkServer {
 
   // Waits up to the idle wait for one frame, processes and answers it, runs the firmware.
   Status step();
-  // Steps until stop() returns true.
+  // Steps until stop() returns true; stop() is also consulted during a paced wait.
   Status run(const std::function<bool()>& stop);
 
   const ServerCounters& counters() const { return counters_; }
@@ -45,6 +53,10 @@ class NetworkServer {
  private:
   Link& link_;
   Segment& segment_;
+  Status step(const std::function<bool()>& stop);
+  // Paced: holds until `t` on the clock; false when stop() was raised first.
+  bool waitUntil(SimTime t, const std::function<bool()>& stop);
+
   const Clock& clock_;
   ServerOptions options_;
   ServerCounters counters_{};

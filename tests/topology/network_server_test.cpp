@@ -63,5 +63,63 @@ TEST(NetworkServer, PacedModeHoldsTheAnswerUntilTheModelledReturnTime) {
   EXPECT_GE(back - sent, modelled) << "not before the modelled return time";
 }
 
+// A clock that moves on by `step` every time it is read, so a paced wait ends (or would, in
+// the unbounded code of issue #21, after a few hundred million reads) without real waiting.
+class SteppingClock final : public Clock {
+ public:
+  explicit SteppingClock(SimTime step) : step_(step) {}
+  SimTime now() const override { return now_ += step_; }
+
+ private:
+  SimTime step_;
+  mutable SimTime now_{0};
+};
+
+// A paced server on a line of two slaves whose cables all take `extra` longer, the clock
+// moving on by `clockStep` per reading, with one frame from the master waiting.
+struct PacedWithDelay {
+  PacedWithDelay(SimTime extra, SimTime clockStep) : clock(clockStep) {
+    buildLine(seg, 2);
+    delay.extra = extra;
+    seg.setWireFaults(&delay);
+    std::array<std::uint8_t, kMaxFrameSize> buf{};
+    const std::size_t len = brdFrame(buf);
+    EXPECT_TRUE(links.first.send(ConstBytes(buf.data(), len)).ok());
+  }
+  ~PacedWithDelay() { seg.setWireFaults(nullptr); }
+  topology::Segment seg;
+  FixedWireDelay delay;
+  std::pair<MemoryLink, MemoryLink> links = MemoryLink::makePair();
+  SteppingClock clock;
+  topology::NetworkServer server{links.second, seg, clock, paced()};
+
+  static topology::ServerOptions paced() {
+    topology::ServerOptions options;
+    options.paced = true;
+    return options;
+  }
+};
+
+// Issue #21: with --paced, `delay ns=1e14` held one answer for 27.8 hours.
+TEST(NetworkServer, PacedModeDoesNotHoldAnAnswerBeyondTheBound) {
+  PacedWithDelay t(100'000 * kNsPerSecond, 10 * kNsPerMs);  // 1e14 ns per cable crossing
+  ASSERT_TRUE(t.server.step().ok());
+  EXPECT_EQ(t.server.counters().framesLate, 1u);
+  EXPECT_EQ(t.server.counters().framesAnswered, 0u);
+  std::array<std::uint8_t, kMaxFrameSize> buf{};
+  auto none = t.links.first.receive(buf, std::chrono::milliseconds(5));
+  ASSERT_TRUE(none.ok());
+  EXPECT_EQ(*none, 0u) << "a frame beyond the paced bound is not answered";
+}
+
+TEST(NetworkServer, PacedWaitEndsWhenStopIsRaised) {
+  // Within the bound: the answer would be held about 0.6 s.
+  PacedWithDelay t(200 * kNsPerMs, 10 * kNsPerUs);
+  int calls = 0;
+  ASSERT_TRUE(t.server.run([&] { return ++calls > 1; }).ok());  // raised during the wait
+  EXPECT_EQ(t.server.counters().framesReceived, 1u);
+  EXPECT_EQ(t.server.counters().framesAnswered, 0u) << "the wait ended without answering";
+}
+
 }  // namespace
 }  // namespace ecsim::testing

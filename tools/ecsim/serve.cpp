@@ -225,9 +225,9 @@ int runServe(ServeOptions o) {
   const auto& sc = segment.counters();
   fmt::print(
       "ecsim: stopped; frames received {}, answered {}, malformed dropped {}, "
-      "receive errors {}, send errors {}, datagrams {}\n",
-      c.framesReceived, c.framesAnswered, c.framesDropped, c.receiveErrors, c.sendErrors,
-      sc.datagramsProcessed);
+      "late (paced, beyond 1 s) {}, receive errors {}, send errors {}, datagrams {}\n",
+      c.framesReceived, c.framesAnswered, c.framesDropped, c.framesLate, c.receiveErrors,
+      c.sendErrors, sc.datagramsProcessed);
   if (!status.ok()) {
     fmt::print(stderr, "ecsim serve: {}\n", status.error().message());
     return 1;
