@@ -1,10 +1,13 @@
 // Reads scenario files (docs/scenarios.md) with tinyxml2; errors name file and line.
 #include <tinyxml2.h>
 
+#include <fmt/core.h>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <regex>
 #include <sstream>
 
@@ -14,6 +17,13 @@ namespace ecsim::scenario {
 namespace {
 
 using tinyxml2::XMLElement;
+
+// Ranges of a scenario's numbers (docs/scenarios.md): times at most a day, as for the fault
+// actions; cycle counts at most those of a day at the shortest cycle (50 us).
+constexpr double kMaxMs = static_cast<double>(topology::kMaxFaultDurationMs);
+constexpr std::uint64_t kMaxCycles = 2'000'000'000;
+constexpr std::uint64_t kMinCycleUs = 50;
+constexpr std::uint64_t kMaxCycleUs = 1'000'000;
 
 class Reader {
  public:
@@ -33,30 +43,46 @@ class Reader {
     if (v == nullptr) return std::nullopt;
     return std::string(v);
   }
-  Result<std::optional<std::uint64_t>> number(const XMLElement* e, const char* name) const {
+  // An integer attribute (decimal or 0x hex) in [lo, hi]; nullopt when absent. Values that do
+  // not fit are refused with the range, never truncated.
+  Result<std::optional<std::uint64_t>> number(const XMLElement* e, const char* name,
+                                              std::uint64_t lo, std::uint64_t hi) const {
     auto text = attr(e, name);
     if (!text) return std::optional<std::uint64_t>();
     auto v = topology::parseNumber(*text);
-    if (!v) return error(e, std::string(name) + "=\"" + *text + "\" is not a number");
+    if (!v || *v < lo || *v > hi) {
+      return error(e, fmt::format("{}=\"{}\" is not a number in [{}, {}]", name, *text, lo, hi));
+    }
     return std::optional<std::uint64_t>(*v);
   }
-  Result<std::optional<double>> real(const XMLElement* e, const char* name) const {
+  // A finite real attribute in [lo, hi]; nullopt when absent.
+  Result<std::optional<double>> real(const XMLElement* e, const char* name,
+                                     double lo = -std::numeric_limits<double>::max(),
+                                     double hi = std::numeric_limits<double>::max()) const {
     auto text = attr(e, name);
     if (!text) return std::optional<double>();
-    if (auto v = topology::parseNumber(*text))
-      return std::optional<double>(static_cast<double>(*v));
-    char* end = nullptr;
-    const double v = std::strtod(text->c_str(), &end);
-    if (end == text->c_str() || *end != '\0' || !std::isfinite(v)) {
-      return error(e, std::string(name) + "=\"" + *text + "\" is not a number");
+    double v = 0;
+    if (auto n = topology::parseNumber(*text)) {
+      v = static_cast<double>(*n);
+    } else {
+      char* end = nullptr;
+      v = std::strtod(text->c_str(), &end);
+      if (end == text->c_str() || *end != '\0') v = std::nan("");
+    }
+    if (!(v >= lo && v <= hi)) {  // NaN fails: refused with the rest
+      constexpr double kMax = std::numeric_limits<double>::max();
+      const std::string range = hi == kMax ? (lo == -kMax ? std::string("finite number")
+                                                          : fmt::format("finite number >= {}", lo))
+                                           : fmt::format("number in [{}, {}]", lo, hi);
+      return error(e, fmt::format("{}=\"{}\" is not a {}", name, *text, range));
     }
     return std::optional<double>(v);
   }
+  // A time in milliseconds, [0, kMaxMs], as nanoseconds.
   Result<std::optional<SimTime>> millis(const XMLElement* e, const char* name) const {
-    ECSIM_ASSIGN_OR_RETURN(auto v, real(e, name));
+    ECSIM_ASSIGN_OR_RETURN(auto v, real(e, name, 0, kMaxMs));
     if (!v) return std::optional<SimTime>();
-    if (*v < 0) return error(e, std::string(name) + " must not be negative");
-    return std::optional<SimTime>(static_cast<SimTime>(std::llround(*v * kNsPerMs)));
+    return std::optional<SimTime>(saturatingTime(*v * static_cast<double>(kNsPerMs)));
   }
   Result<std::optional<bool>> boolean(const XMLElement* e, const char* name) const {
     auto text = attr(e, name);
@@ -84,7 +110,7 @@ Result<Compare> parseCompare(const Reader& r, const XMLElement* e) {
 Result<TimedAction> readAction(const Reader& r, const XMLElement* e) {
   TimedAction a;
   a.line = e->GetLineNum();
-  ECSIM_ASSIGN_OR_RETURN(a.cycle, r.number(e, "cycle"));
+  ECSIM_ASSIGN_OR_RETURN(a.cycle, r.number(e, "cycle", 0, kMaxCycles));
   ECSIM_ASSIGN_OR_RETURN(a.time, r.millis(e, "timeMs"));
   if (a.cycle.has_value() == a.time.has_value()) {
     return r.error(e, "an Action needs exactly one of cycle=\"N\" and timeMs=\"T\"");
@@ -109,14 +135,15 @@ Result<Expectation> readExpectation(const Reader& r, const XMLElement* e) {
   Expectation x;
   x.line = e->GetLineNum();
   const std::string tag = e->Name();
-  ECSIM_ASSIGN_OR_RETURN(x.atCycle, r.number(e, "cycle"));
+  ECSIM_ASSIGN_OR_RETURN(x.atCycle, r.number(e, "cycle", 0, kMaxCycles));
   ECSIM_ASSIGN_OR_RETURN(x.atTime, r.millis(e, "atMs"));
   ECSIM_ASSIGN_OR_RETURN(auto needs, r.boolean(e, "needsRecovery"));
   x.needsRecovery = needs.value_or(false);
   x.slave = Reader::attr(e, "slave").value_or("");
   ECSIM_ASSIGN_OR_RETURN(x.compare, parseCompare(r, e));
   ECSIM_ASSIGN_OR_RETURN(auto value, r.real(e, "value"));
-  ECSIM_ASSIGN_OR_RETURN(auto tolerance, r.real(e, "tolerance"));
+  ECSIM_ASSIGN_OR_RETURN(auto tolerance,
+                         r.real(e, "tolerance", 0, std::numeric_limits<double>::max()));
   x.value = value.value_or(0);
   x.tolerance = tolerance.value_or(0);
   auto needSlave = [&]() -> Status {
@@ -136,7 +163,7 @@ Result<Expectation> readExpectation(const Reader& r, const XMLElement* e) {
       return r.error(e, "State needs state=\"INIT|PREOP|SAFEOP|OP|BOOT\"");
     }
     ECSIM_ASSIGN_OR_RETURN(x.error, r.boolean(e, "error"));
-    ECSIM_ASSIGN_OR_RETURN(auto code, r.number(e, "code"));
+    ECSIM_ASSIGN_OR_RETURN(auto code, r.number(e, "code", 0, 0xFFFF));
     if (code) x.code = static_cast<std::uint16_t>(*code);
   } else if (tag == "Detected") {
     x.kind = ExpectKind::kDetected;
@@ -149,14 +176,14 @@ Result<Expectation> readExpectation(const Reader& r, const XMLElement* e) {
       }
       return r.error(e, "condition must be one of " + names);
     }
-    ECSIM_ASSIGN_OR_RETURN(auto after, r.number(e, "afterCycle"));
-    ECSIM_ASSIGN_OR_RETURN(auto within, r.number(e, "withinCycles"));
+    ECSIM_ASSIGN_OR_RETURN(auto after, r.number(e, "afterCycle", 0, kMaxCycles));
+    ECSIM_ASSIGN_OR_RETURN(auto within, r.number(e, "withinCycles", 0, kMaxCycles));
     if (!within) return r.error(e, "Detected needs withinCycles=\"N\"");
     x.afterCycle = after.value_or(0);
     x.withinCycles = *within;
   } else if (tag == "BackInOp") {
     x.kind = ExpectKind::kBackInOp;
-    ECSIM_ASSIGN_OR_RETURN(auto after, r.number(e, "afterCycle"));
+    ECSIM_ASSIGN_OR_RETURN(auto after, r.number(e, "afterCycle", 0, kMaxCycles));
     ECSIM_ASSIGN_OR_RETURN(auto within, r.millis(e, "withinMs"));
     ECSIM_ASSIGN_OR_RETURN(x.afterTime, r.millis(e, "afterMs"));
     if (!within) return r.error(e, "BackInOp needs withinMs=\"T\"");
@@ -205,13 +232,13 @@ Result<Expectation> readExpectation(const Reader& r, const XMLElement* e) {
     x.kind = ExpectKind::kRegister;
     ECSIM_TRY(needSlave());
     ECSIM_TRY(needValue());
-    ECSIM_ASSIGN_OR_RETURN(auto address, r.number(e, "address"));
-    ECSIM_ASSIGN_OR_RETURN(auto width, r.number(e, "width"));
+    ECSIM_ASSIGN_OR_RETURN(auto address, r.number(e, "address", 0, 0x0FFF));
+    ECSIM_ASSIGN_OR_RETURN(auto width, r.number(e, "width", 1, 4));
     if (!address || *address >= 0x1000)
       return r.error(e, "Register needs address=\"0x0000-0x0FFF\"");
     x.address = static_cast<std::uint16_t>(*address);
     x.width = static_cast<unsigned>(width.value_or(1));
-    ECSIM_ASSIGN_OR_RETURN(auto mask, r.number(e, "mask"));
+    ECSIM_ASSIGN_OR_RETURN(auto mask, r.number(e, "mask", 0, 0xFFFFFFFF));
     x.mask = static_cast<std::uint32_t>(mask.value_or(0xFFFFFFFF));
     if (x.width != 1 && x.width != 2 && x.width != 4) return r.error(e, "width must be 1, 2 or 4");
   } else if (tag == "Statistic") {
@@ -221,8 +248,8 @@ Result<Expectation> readExpectation(const Reader& r, const XMLElement* e) {
     if (x.name.empty()) return r.error(e, "Statistic needs name=\"...\"");
   } else if (tag == "Continuity") {
     x.kind = ExpectKind::kContinuity;
-    ECSIM_ASSIGN_OR_RETURN(auto bad, r.number(e, "maxBadCycles"));
-    ECSIM_ASSIGN_OR_RETURN(auto run, r.number(e, "maxConsecutiveBadCycles"));
+    ECSIM_ASSIGN_OR_RETURN(auto bad, r.number(e, "maxBadCycles", 0, kMaxCycles));
+    ECSIM_ASSIGN_OR_RETURN(auto run, r.number(e, "maxConsecutiveBadCycles", 0, kMaxCycles));
     if (!bad && !run) {
       return r.error(e, "Continuity needs maxBadCycles and/or maxConsecutiveBadCycles");
     }
@@ -242,7 +269,7 @@ Result<Expectation> readExpectation(const Reader& r, const XMLElement* e) {
     }
     x.index = static_cast<std::uint16_t>(*index);
     x.subindex = static_cast<std::uint8_t>(*sub);
-    ECSIM_ASSIGN_OR_RETURN(auto mask, r.number(e, "mask"));
+    ECSIM_ASSIGN_OR_RETURN(auto mask, r.number(e, "mask", 0, 0xFFFFFFFF));
     x.mask = static_cast<std::uint32_t>(mask.value_or(0xFFFFFFFF));
     ECSIM_ASSIGN_OR_RETURN(auto isSigned, r.boolean(e, "signed"));
     x.isSigned = isSigned.value_or(false);
@@ -316,13 +343,11 @@ Result<Scenario> parseScenario(std::string_view xml, const std::filesystem::path
   auto topology = Reader::attr(root, "topology");
   if (!topology) return r.error(root, "Scenario needs topology=\"PATH\"");
   s.topology = path.parent_path() / *topology;
-  ECSIM_ASSIGN_OR_RETURN(auto cycleUs, r.number(root, "cycleUs"));
+  ECSIM_ASSIGN_OR_RETURN(auto cycleUs, r.number(root, "cycleUs", kMinCycleUs, kMaxCycleUs));
   ECSIM_ASSIGN_OR_RETURN(auto duration, r.millis(root, "durationMs"));
-  ECSIM_ASSIGN_OR_RETURN(auto seed, r.number(root, "seed"));
-  if (cycleUs) {
-    if (*cycleUs < 50 || *cycleUs > 1000000) return r.error(root, "cycleUs must be 50..1000000");
-    s.cycleTime = static_cast<SimTime>(*cycleUs) * kNsPerUs;
-  }
+  ECSIM_ASSIGN_OR_RETURN(auto seed,
+                         r.number(root, "seed", 0, std::numeric_limits<std::uint64_t>::max()));
+  if (cycleUs) s.cycleTime = saturatingMul(static_cast<SimTime>(*cycleUs), kNsPerUs);
   if (duration) s.duration = *duration;
   if (s.duration < s.cycleTime) return r.error(root, "durationMs is shorter than one cycle");
   s.seed = seed.value_or(1);

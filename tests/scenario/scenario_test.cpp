@@ -66,6 +66,56 @@ TEST(ScenarioFile, ErrorsNameFileAndLine) {
   EXPECT_NE(s.error().context.find("recovery-failed"), std::string::npos) << s.error().context;
 }
 
+// Issue #21: a scenario's numbers have ranges; NaN, infinities, values beyond the range
+// (durationMs="1e300" was an unchecked double to int64 cast) and integers that do not fit their
+// field (code, mask: truncated before) are refused with the range and the line.
+TEST(ScenarioFile, NumbersOutOfRangeAreRefusedWithTheRange) {
+  const std::string expect = "<Expect><State slave=\"A\" state=\"OP\"/></Expect>\n";
+  auto root = [&](const std::string& attributes) {
+    return "<?xml version=\"1.0\"?>\n<Scenario name=\"t\" topology=\"demo.xml\" " + attributes +
+           ">\n" + expect + "</Scenario>\n";
+  };
+  struct Case {
+    std::string xml;
+    const char* expected;
+  };
+  const Case cases[] = {
+      {root("durationMs=\"1e300\""),
+       "line 2: durationMs=\"1e300\" is not a number in [0, 86400000]"},
+      {root("durationMs=\"nan\""), "durationMs=\"nan\" is not a number in [0, 86400000]"},
+      {root("durationMs=\"-inf\""), "[0, 86400000]"},
+      {root("cycleUs=\"18446744073709551615\""),
+       "cycleUs=\"18446744073709551615\" is not a "
+       "number in [50, 1000000]"},
+      {root("cycleUs=\"10\""), "[50, 1000000]"},
+      {wrap("<Timeline>\n<Action timeMs=\"1e20\" do=\"link-down\" cable=\"c\"/>\n</Timeline>\n" +
+            expect),
+       "line 4: timeMs=\"1e20\" is not a number in [0, 86400000]"},
+      {wrap("<Timeline>\n<Action cycle=\"99999999999\" do=\"link-down\" cable=\"c\"/>\n"
+            "</Timeline>\n" +
+            expect),
+       "line 4: cycle=\"99999999999\" is not a number in [0, 2000000000]"},
+      {wrap("<Expect>\n<State slave=\"A\" state=\"OP\" code=\"0x1FFFFFFFFFF\"/></Expect>\n"),
+       "line 4: code=\"0x1FFFFFFFFFF\" is not a number in [0, 65535]"},
+      {wrap("<Expect>\n<Register slave=\"A\" address=\"0x310\" value=\"1\" "
+            "mask=\"0x1FFFFFFFF\"/></Expect>\n"),
+       "line 4: mask=\"0x1FFFFFFFF\" is not a number in [0, 4294967295]"},
+      {wrap("<Expect>\n<BackInOp withinMs=\"inf\"/></Expect>\n"),
+       "line 4: withinMs=\"inf\" is not a number in [0, 86400000]"},
+      {wrap("<Expect>\n<Register slave=\"A\" address=\"0x310\" value=\"nan\"/></Expect>\n"),
+       "line 4: value=\"nan\" is not a finite number"},
+      {wrap("<Expect>\n<Register slave=\"A\" address=\"0x310\" value=\"1\" "
+            "tolerance=\"-1\"/></Expect>\n"),
+       "line 4: tolerance=\"-1\" is not a finite number >= 0"},
+  };
+  for (const Case& c : cases) {
+    auto s = parseScenario(c.xml, "n.xml");
+    ASSERT_FALSE(s.ok()) << c.xml;
+    EXPECT_NE(s.error().context.find(c.expected), std::string::npos)
+        << c.expected << "\n  got: " << s.error().context;
+  }
+}
+
 TEST(Runner, AFailingExpectationSaysWhatWhenAndWhat) {
   auto s = loadScenario(kDir / "cable_break.xml");
   ASSERT_TRUE(s.ok()) << s.error().message();
