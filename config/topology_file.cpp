@@ -1,5 +1,8 @@
 #include "config/topology_file.hpp"
 
+#include <fmt/core.h>
+
+#include <charconv>
 #include <fstream>
 #include <sstream>
 
@@ -32,16 +35,35 @@ Result<std::pair<std::size_t, unsigned>> parseEndpoint(const xml::Context& ctx, 
   return std::make_pair(*slave, static_cast<unsigned>(port));
 }
 
+// A real attribute in [lo, hi] (`fallback` when absent); NaN and infinities are refused.
 Result<double> attrDouble(const xml::Context& ctx, const Element* e, const char* name,
-                          double fallback) {
+                          double fallback, double lo, double hi, std::string_view why) {
   const char* raw = e->Attribute(name);
   if (raw == nullptr) return fallback;
+  const std::string_view text(raw);
   double v = 0;
-  if (e->QueryDoubleAttribute(name, &v) != tinyxml2::XML_SUCCESS) {
-    return ctx.error(e, std::string("attribute ") + name + ": '" + raw + "' is not a number");
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  // Written so that NaN fails the range test.
+  if (ec != std::errc() || end != text.data() + text.size() || !(v >= lo && v <= hi)) {
+    return ctx.error(
+        e, fmt::format("attribute {}: '{}' is not a number in [{}, {}]{}", name, raw, lo, hi, why));
   }
   return v;
 }
+
+// An integer attribute in [lo, hi], or nullopt when absent.
+Result<std::optional<std::int64_t>> attrInteger(const xml::Context& ctx, const Element* e,
+                                                const char* name, std::int64_t lo,
+                                                std::int64_t hi) {
+  ECSIM_ASSIGN_OR_RETURN(auto v, xml::attrNumber<std::int64_t>(ctx, e, name));
+  if (v && (*v < lo || *v > hi)) {
+    return ctx.error(e, fmt::format("attribute {}: '{}' is not a number in [{}, {}]", name,
+                                    e->Attribute(name), lo, hi));
+  }
+  return v;
+}
+
+constexpr std::string_view kCableWhy = " m (the 100BASE-TX segment limit)";
 
 Result<TopologySlave> parseSlave(const xml::Context& ctx, const Element* e,
                                  const std::filesystem::path& folder) {
@@ -75,16 +97,15 @@ Result<TopologySlave> parseSlave(const xml::Context& ctx, const Element* e,
     }
   }
   ECSIM_ASSIGN_OR_RETURN(s.processingDelayNs,
-                         xml::attrNumber<std::int64_t>(ctx, e, "processingDelayNs"));
+                         attrInteger(ctx, e, "processingDelayNs", 0, kMaxEscDelayNs));
   ECSIM_ASSIGN_OR_RETURN(s.forwardingDelayNs,
-                         xml::attrNumber<std::int64_t>(ctx, e, "forwardingDelayNs"));
+                         attrInteger(ctx, e, "forwardingDelayNs", 0, kMaxEscDelayNs));
   if (const Element* clock = e->FirstChildElement("Clock")) {
-    ECSIM_ASSIGN_OR_RETURN(auto offset, xml::attrNumber<std::int64_t>(ctx, clock, "offsetNs"));
+    ECSIM_ASSIGN_OR_RETURN(
+        auto offset, attrInteger(ctx, clock, "offsetNs", -kMaxClockOffsetNs, kMaxClockOffsetNs));
     s.clockOffsetNs = offset.value_or(0);
-    ECSIM_ASSIGN_OR_RETURN(s.driftPpm, attrDouble(ctx, clock, "driftPpm", 0.0));
-    if (s.driftPpm < -1000.0 || s.driftPpm > 1000.0) {
-      return ctx.error(clock, "driftPpm must be within +-1000");
-    }
+    ECSIM_ASSIGN_OR_RETURN(
+        s.driftPpm, attrDouble(ctx, clock, "driftPpm", 0.0, -kMaxDriftPpm, kMaxDriftPpm, " ppm"));
   }
   if (const char* state = e->Attribute("stateFile")) s.stateFile = folder / state;
   s.folder = folder;
@@ -119,7 +140,12 @@ Result<TopologySlave> parseSlave(const xml::Context& ctx, const Element* e,
 }  // namespace
 
 std::optional<std::size_t> TopologyConfig::findSlave(std::string_view n) const {
-  for (std::size_t i = 0; i < slaves.size(); ++i) {
+  if (byName.size() == slaves.size()) {
+    auto it = byName.find(n);
+    if (it == byName.end()) return std::nullopt;
+    return it->second;
+  }
+  for (std::size_t i = 0; i < slaves.size(); ++i) {  // slaves filled in without the index
     if (slaves[i].name == n) return i;
   }
   return std::nullopt;
@@ -138,11 +164,18 @@ Result<TopologyConfig> parseTopology(std::string_view text, const std::filesyste
   if (const char* name = root->Attribute("name")) cfg.name = name;
   const std::filesystem::path folder = file.parent_path();
   if (const Element* master = root->FirstChildElement("Master")) {
-    ECSIM_ASSIGN_OR_RETURN(cfg.masterCableMetres, attrDouble(ctx, master, "cable", 1.0));
+    ECSIM_ASSIGN_OR_RETURN(cfg.masterCableMetres,
+                           attrDouble(ctx, master, "cable", 1.0, 0, kMaxCableMetres, kCableWhy));
   }
   for (const Element* e : xml::Children(root, "Slave")) {
+    if (cfg.slaves.size() == kMaxSlaves) {
+      return ctx.error(
+          e, fmt::format("more than {} slaves (the address space of a segment)", kMaxSlaves));
+    }
     ECSIM_ASSIGN_OR_RETURN(auto slave, parseSlave(ctx, e, folder));
-    if (cfg.findSlave(slave.name)) return ctx.error(e, "duplicate slave name '" + slave.name + "'");
+    if (!cfg.byName.emplace(slave.name, cfg.slaves.size()).second) {
+      return ctx.error(e, "duplicate slave name '" + slave.name + "'");
+    }
     cfg.slaves.push_back(std::move(slave));
   }
   if (cfg.slaves.empty()) return ctx.error(root, "topology has no <Slave>");
@@ -156,10 +189,8 @@ Result<TopologyConfig> parseTopology(std::string_view text, const std::filesyste
     link.fromPort = from.second;
     link.toSlave = to.first;
     link.toPort = to.second;
-    ECSIM_ASSIGN_OR_RETURN(link.cableMetres, attrDouble(ctx, e, "cable", 1.0));
-    if (link.cableMetres < 0 || link.cableMetres > 100) {
-      return ctx.error(e, "cable length must be 0..100 m (100BASE-TX segment limit)");
-    }
+    ECSIM_ASSIGN_OR_RETURN(link.cableMetres,
+                           attrDouble(ctx, e, "cable", 1.0, 0, kMaxCableMetres, kCableWhy));
     cfg.links.push_back(link);
   }
   cfg.explicitLinks = !cfg.links.empty();

@@ -6,14 +6,25 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "protocol/frame.hpp"  // kMaxSlaves
 #include "protocol/result.hpp"
 
 namespace ecsim {
+
+// Ranges of a topology file's numbers (docs/topology.md); a value outside is an error naming the
+// file, line and range.
+constexpr double kMaxCableMetres = 100.0;           // a 100BASE-TX segment
+constexpr std::int64_t kMaxEscDelayNs = 1'000'000;  // processing/forwarding delay, 1 ms
+// Local time at simulation time 0: about 126 years either way of the DC epoch, leaving room
+// for runs of centuries before SimTime's end.
+constexpr std::int64_t kMaxClockOffsetNs = 4'000'000'000'000'000'000;
+constexpr double kMaxDriftPpm = 1000.0;
 
 struct TopologyInput {  // an initial input value: object entry and value
   std::uint16_t index{0};
@@ -66,6 +77,9 @@ struct TopologyConfig {
   std::vector<TopologySlave> slaves;  // in the order written; slave 0 is at the master
   std::vector<TopologyLink> links;    // empty in the file: a line in written order
   bool explicitLinks{false};
+  // Slave index by name, filled by parseTopology (findSlave falls back to a search when a
+  // caller filled `slaves` itself).
+  std::map<std::string, std::size_t, std::less<>> byName;
 
   std::optional<std::size_t> findSlave(std::string_view name) const;
 };

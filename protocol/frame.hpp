@@ -126,6 +126,11 @@ struct EtherCatHeader {
   }
 };
 
+// The most slaves one segment can address: positions (auto-increment ADP 0, -1, ...) and
+// station addresses are 16 bits, station address 0 meaning none. Topology and ENI files with
+// more are refused.
+constexpr std::size_t kMaxSlaves = 65'535;
+
 struct DatagramHeader {
   Command command{Command::kNop};
   std::uint8_t index{0};

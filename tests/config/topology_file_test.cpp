@@ -100,7 +100,51 @@ INSTANTIATE_TEST_SUITE_P(
                 "line 3: attribute driftPpm"},
         BadCase{"<Topology>\n<Slave name=\"A\"/>\n<Slave name=\"B\"/>\n<Link from=\"A:1\" "
                 "to=\"B:0\" cable=\"150\"/>\n</Topology>",
-                "line 4: cable length"}));
+                "line 4: attribute cable: '150' is not a number in [0, 100] m"},
+        // Issue #21: numbers outside their range, NaN and infinities were accepted.
+        BadCase{"<Topology>\n<Master cable=\"1e300\"/>\n<Slave name=\"A\"/>\n</Topology>",
+                "line 2: attribute cable: '1e300' is not a number in [0, 100]"},
+        BadCase{"<Topology>\n<Master cable=\"-5\"/>\n<Slave name=\"A\"/>\n</Topology>",
+                "line 2: attribute cable: '-5' is not a number in [0, 100]"},
+        BadCase{"<Topology>\n<Master cable=\"2m\"/>\n<Slave name=\"A\"/>\n</Topology>",
+                "line 2: attribute cable: '2m' is not a number"},
+        BadCase{"<Topology>\n<Slave name=\"A\"/>\n<Slave name=\"B\"/>\n<Link from=\"A:1\" "
+                "to=\"B:0\" cable=\"nan\"/>\n</Topology>",
+                "line 4: attribute cable: 'nan' is not a number in [0, 100]"},
+        BadCase{"<Topology>\n<Slave name=\"A\" processingDelayNs=\"9223372036854775807\"/>\n"
+                "</Topology>",
+                "line 2: attribute processingDelayNs: '9223372036854775807' is not a number in "
+                "[0, 1000000]"},
+        BadCase{"<Topology>\n<Slave name=\"A\" forwardingDelayNs=\"-100\"/>\n</Topology>",
+                "line 2: attribute forwardingDelayNs: '-100' is not a number in [0, 1000000]"},
+        BadCase{"<Topology>\n<Slave name=\"A\">\n<Clock offsetNs=\"9223372036854775807\"/>\n"
+                "</Slave>\n</Topology>",
+                "line 3: attribute offsetNs: '9223372036854775807' is not a number in "
+                "[-4000000000000000000, 4000000000000000000]"},
+        BadCase{"<Topology>\n<Slave name=\"A\">\n<Clock driftPpm=\"nan\"/>\n</Slave>\n"
+                "</Topology>",
+                "line 3: attribute driftPpm: 'nan' is not a number in [-1000, 1000] ppm"},
+        BadCase{"<Topology>\n<Slave name=\"A\">\n<Clock driftPpm=\"-inf\"/>\n</Slave>\n"
+                "</Topology>",
+                "line 3: attribute driftPpm: '-inf' is not a number in [-1000, 1000]"}));
+
+std::string slaves(std::size_t n) {
+  std::string xml = "<Topology>\n";
+  for (std::size_t i = 0; i < n; ++i) xml += "<Slave name=\"S" + std::to_string(i) + "\"/>\n";
+  return xml + "</Topology>\n";
+}
+
+// Issue #21 item 9: a segment addresses at most 65,535 slaves.
+TEST(TopologyFile, MoreSlavesThanTheAddressSpaceAreRefused) {
+  auto most = parseTopology(slaves(65'535), kFile);
+  ASSERT_TRUE(most.ok()) << most.error().message();
+  EXPECT_EQ(most->slaves.size(), 65'535u);
+  EXPECT_EQ(most->findSlave("S65534"), 65'534u);
+  auto over = parseTopology(slaves(65'536), kFile);
+  ASSERT_FALSE(over.ok());
+  EXPECT_NE(over.error().context.find("line 65537: more than 65535 slaves"), std::string::npos)
+      << over.error().context;
+}
 
 TEST(TopologyFile, MissingFileIsAClearError) {
   auto t = loadTopologyFile("/nonexistent/ecsim/topology.xml");
