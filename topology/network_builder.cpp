@@ -1,5 +1,7 @@
 #include "topology/network_builder.hpp"
 
+#include <fmt/core.h>
+
 #include <fstream>
 
 #include "protocol/sii.hpp"
@@ -111,6 +113,11 @@ Result<std::unique_ptr<slavesim::Slave>> SlaveFactory::make(const TopologySlave&
 }
 
 Result<Network> buildNetwork(const TopologyConfig& config) {
+  if (config.slaves.size() > kMaxSlaves) {
+    return makeError(ErrorCode::kInvalidArgument,
+                     fmt::format("{}: {} slaves, more than {} (the address space of a segment)",
+                                 config.file.string(), config.slaves.size(), kMaxSlaves));
+  }
   SlaveFactory factory;
   Network net;
   net.segment = std::make_unique<Segment>();

@@ -114,6 +114,8 @@ class Segment {
 
   // Updates each slave's DL status (0x0110) from the wiring and port states.
   void refreshLinkStatus();
+  // The same for one slave (its ports' states depend on its neighbours' link flags only).
+  void refreshLinkStatus(std::size_t slave);
   // Opens or closes a port (a pulled cable closes both ends' links).
   void setLinkUp(std::size_t slave, unsigned port, bool up);
 

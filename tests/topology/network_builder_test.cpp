@@ -53,5 +53,17 @@ TEST(NetworkBuilder, PortBeyondTheEscIsRefused) {
   EXPECT_NE(net.error().context.find("line 4"), std::string::npos) << net.error().context;
 }
 
+// Issue #21 item 9: a configuration filled in by a program is checked as a file is.
+TEST(NetworkBuilder, MoreSlavesThanTheAddressSpaceAreRefused) {
+  TopologyConfig cfg;
+  cfg.file = "big.xml";
+  cfg.slaves.resize(65'536);
+  for (auto& s : cfg.slaves) s.builtin = "generic";
+  auto net = topology::buildNetwork(cfg);
+  ASSERT_FALSE(net.ok());
+  EXPECT_NE(net.error().context.find("65536 slaves, more than 65535"), std::string::npos)
+      << net.error().context;
+}
+
 }  // namespace
 }  // namespace ecsim::testing
