@@ -1,10 +1,12 @@
 // Reads ENI files with tinyxml2 through config/xml_util.hpp (errors name file and line).
 #include "config/eni.hpp"
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 
 #include "config/xml_util.hpp"
+#include "protocol/frame.hpp"  // kMaxSlaves
 
 namespace ecsim {
 namespace {
@@ -316,25 +318,51 @@ Result<EniConfig> parseEni(std::string_view text, const std::filesystem::path& f
     eni.master.name = std::string(xml::childText(m->FirstChildElement("Info"), "Name"));
     ECSIM_ASSIGN_OR_RETURN(eni.master.initCmds, registerCmds(ctx, m));
   }
+  // The line of the slave at each station address (0: none yet): checks in constant time,
+  // so reading is linear in the number of slaves.
+  std::vector<int> lineAt(std::size_t{1} << 16, 0);
   for (const Element* s : Children(config, "Slave")) {
+    if (eni.slaves.size() == kMaxSlaves) {
+      return ctx.error(s, "more than " + std::to_string(kMaxSlaves) +
+                              " slaves (the address space of a segment)");
+    }
     ECSIM_ASSIGN_OR_RETURN(EniSlave parsed, slave(ctx, s));
-    if (const EniSlave* twin = eni.findSlave(parsed.physAddr)) {
+    if (const int twin = lineAt[parsed.physAddr]; twin != 0) {
       return ctx.error(s, "PhysAddr " + std::to_string(parsed.physAddr) +
-                              " is already used by the slave on line " +
-                              std::to_string(twin->line));
+                              " is already used by the slave on line " + std::to_string(twin));
     }
     for (const auto& prev : parsed.previousPorts) {
-      if (eni.findSlave(prev.physAddr) == nullptr) {
+      if (lineAt[prev.physAddr] == 0) {
         return ctx.error(s, "PreviousPort names PhysAddr " + std::to_string(prev.physAddr) +
                                 ", which no earlier slave has");
       }
     }
+    if (parsed.dcCycleTimeNs == 0u) parsed.dcCycleTimeNs.reset();  // 0: not used
+    if (parsed.dcCycleTimeNs && *parsed.dcCycleTimeNs > kMaxEniDcCycleTimeNs) {
+      const Element* at = s->FirstChildElement("DC")->FirstChildElement("CycleTime0");
+      eni.warnings.push_back(ctx.error(at, "DC CycleTime0 " +
+                                               std::to_string(*parsed.dcCycleTimeNs) +
+                                               " ns is outside [0, " +
+                                               std::to_string(kMaxEniDcCycleTimeNs) + "]: ignored")
+                                 .context);
+      parsed.dcCycleTimeNs.reset();
+    }
+    lineAt[parsed.physAddr] = std::max(parsed.line, 1);
     eni.slaves.push_back(std::move(parsed));
   }
   for (const Element* c : Children(config, "Cyclic")) {
     EniCyclic cyclic;
     ECSIM_ASSIGN_OR_RETURN(cyclic.cycleTimeUs,
                            xml::childNumber<std::uint32_t>(ctx, c, "CycleTime"));
+    if (cyclic.cycleTimeUs &&
+        (*cyclic.cycleTimeUs == 0 || *cyclic.cycleTimeUs > kMaxEniCycleTimeUs)) {
+      eni.warnings.push_back(ctx.error(c->FirstChildElement("CycleTime"),
+                                       "CycleTime " + std::to_string(*cyclic.cycleTimeUs) +
+                                           " us is outside [1, " +
+                                           std::to_string(kMaxEniCycleTimeUs) + "]: ignored")
+                                 .context);
+      cyclic.cycleTimeUs.reset();
+    }
     for (const Element* f : Children(c, "Frame")) {
       EniFrame frame;
       for (const Element* cmd : Children(f, "Cmd")) {

@@ -190,8 +190,14 @@ struct EniMaster {
   std::vector<EniRegisterCmd> initCmds;
 };
 
+// Cycle times beyond these are taken for absurd: a warning (file and line) and the value is
+// ignored, as if absent (ENI files come from vendor tools; a real master would not run them).
+constexpr std::uint32_t kMaxEniCycleTimeUs = 1'000'000;        // <Cyclic><CycleTime>, 1 s
+constexpr std::uint32_t kMaxEniDcCycleTimeNs = 1'000'000'000;  // <DC><CycleTime0>, 1 s
+
 struct EniConfig {
-  std::filesystem::path file;  // for messages
+  std::filesystem::path file;         // for messages
+  std::vector<std::string> warnings;  // "file, line N: ..." for values ignored
   EniMaster master;
   std::vector<EniSlave> slaves;  // in bus order
   std::vector<EniCyclic> cyclic;

@@ -171,6 +171,44 @@ TEST(EniTest, MalformedFilesNameTheLine) {
                     "");
 }
 
+// Issue #21 item 9: a segment addresses at most 65,535 slaves; reading is linear in their
+// number (the duplicate-address check searched all earlier slaves for each).
+TEST(EniTest, MoreSlavesThanTheAddressSpaceAreRefused) {
+  auto slaves = [](std::size_t n) {
+    std::string body;
+    for (std::size_t i = 0; i < n; ++i) {
+      body += "<Slave><Info><PhysAddr>" + std::to_string(i) +
+              "</PhysAddr><VendorId>2</VendorId><ProductCode>1</ProductCode></Info></Slave>\n";
+    }
+    return eniWith(body);
+  };
+  auto most = parseEni(slaves(65'535), "big.xml");
+  ASSERT_TRUE(most.ok()) << most.error().message();
+  EXPECT_EQ(most->slaves.size(), 65'535u);
+  // 65,536 distinct 16-bit addresses: the last slave is one too many.
+  expectErrorAtLine(slaves(65'536), 65'539, "more than 65535 slaves");
+}
+
+// Issue #21: cycle times are bounded; vendor files are tolerant, so an absurd one is a warning
+// naming file and line, and the value is ignored.
+TEST(EniTest, AbsurdCycleTimesAreWarnedAboutAndIgnored) {
+  auto eni = parseEni(eniWith("<Slave>\n" + kInfo +
+                              "<DC>\n<CycleTime0>4000000000</CycleTime0>\n"
+                              "</DC>\n</Slave>\n<Cyclic>\n<CycleTime>0</CycleTime>\n</Cyclic>\n"),
+                      "odd.xml");
+  ASSERT_TRUE(eni.ok()) << eni.error().message();
+  ASSERT_EQ(eni->warnings.size(), 2u);
+  EXPECT_NE(eni->warnings[0].find("odd.xml, line 7: DC CycleTime0 4000000000 ns is outside "
+                                  "[0, 1000000000]: ignored"),
+            std::string::npos)
+      << eni->warnings[0];
+  EXPECT_NE(eni->warnings[1].find("odd.xml, line 11: CycleTime 0 us is outside [1, 1000000]"),
+            std::string::npos)
+      << eni->warnings[1];
+  EXPECT_FALSE(eni->slaves[0].dcCycleTimeNs);
+  EXPECT_FALSE(eni->cyclic[0].cycleTimeUs);
+}
+
 TEST(EniTest, MasterConfigReadsEniOrTheSimpleFormat) {
   auto fromEni = loadMasterConfig(kDemoEni);
   ASSERT_TRUE(fromEni.ok()) << fromEni.error().message();
