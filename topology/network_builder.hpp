@@ -25,6 +25,9 @@ struct CableRef {
 struct Network {
   std::unique_ptr<Segment> segment;
   std::vector<CableRef> cables;  // "master" first (slave 0, port 0), then the file's links
+  // Values a tolerant reader ignored ("file, line N: ..."; e.g. an ENI's absurd cycle time),
+  // for the tool to show.
+  std::vector<std::string> warnings;
   const CableRef* findCable(std::string_view name) const;
 };
 

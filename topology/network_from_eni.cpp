@@ -118,7 +118,9 @@ Result<Network> buildNetworkFromEni(const std::filesystem::path& eniFile,
                                     const std::vector<std::filesystem::path>& esiDirs) {
   ECSIM_ASSIGN_OR_RETURN(EniConfig eni, loadEniFile(eniFile));
   ECSIM_ASSIGN_OR_RETURN(TopologyConfig config, topologyFromEni(eni, esiDirs));
-  return buildNetwork(config);
+  ECSIM_ASSIGN_OR_RETURN(Network network, buildNetwork(config));
+  network.warnings = std::move(eni.warnings);
+  return network;
 }
 
 }  // namespace ecsim::topology

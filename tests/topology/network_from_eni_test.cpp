@@ -4,6 +4,9 @@
 #include "topology/network_from_eni.hpp"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <fstream>
 
 namespace ecsim::testing {
 namespace {
@@ -70,6 +73,27 @@ TEST(NetworkFromEni, LineWithoutPreviousPorts) {
   EXPECT_EQ(config->links[1].fromPort, 1u);
   EXPECT_EQ(config->links[1].toSlave, 2u);
   EXPECT_EQ(config->links[1].name, "B:1-C:0");
+}
+
+// Issue #21: an ENI value the reader ignored reaches the network's warnings (ecsim serve
+// prints them) instead of vanishing.
+TEST(NetworkFromEni, IgnoredValuesAreWarningsOfTheNetwork) {
+  std::string text = eniText({{"A", 1, 0x1100, 0, 'A'}});
+  const std::string end = "</Config>";
+  text.insert(text.find(end), "<Cyclic><CycleTime>5000000</CycleTime></Cyclic>\n");
+  const auto file = std::filesystem::path(::testing::TempDir()) /
+                    ("ecsim_eni_warning_" + std::to_string(::getpid()) + ".xml");
+  {
+    std::ofstream out(file);
+    out << text;
+  }
+  auto network = topology::buildNetworkFromEni(file, {kEsiDir});
+  std::filesystem::remove(file);
+  ASSERT_TRUE(network.ok()) << network.error().message();
+  ASSERT_EQ(network->warnings.size(), 1u);
+  EXPECT_NE(network->warnings[0].find("line 7: CycleTime 5000000 us is outside [1, 1000000]"),
+            std::string::npos)
+      << network->warnings[0];
 }
 
 TEST(NetworkFromEni, UnknownDeviceNamesTheEniLine) {

@@ -115,6 +115,7 @@ int runServe(ServeOptions o) {
       return 1;
     }
     network = std::move(built).value();
+    for (const auto& w : network.warnings) fmt::print(stderr, "ecsim serve: warning: {}\n", w);
   } else if (!o.topology.empty()) {
     auto config = loadTopologyFile(o.topology);
     if (!config.ok()) {
