@@ -61,9 +61,13 @@ class Checker {
     return result_;
   }
   std::string where(std::size_t i) const {
+    const auto& d = req_[i];
+    if (isLogical(d.command())) {
+      return fmt::format("datagram {} ({} logical 0x{:08X} length {})", i, toString(d.command()),
+                         d.address(), d.length());
+    }
     return fmt::format("datagram {} ({} ADP 0x{:04X} ADO 0x{:04X} length {})", i,
-                       toString(req_[i].command()), req_[i].adp(), req_[i].ado(),
-                       req_[i].length());
+                       toString(d.command()), d.adp(), d.ado(), d.length());
   }
   // Command, index and length come back unchanged; auto-increment and broadcast datagrams
   // come back with ADP + number of slaves; every other address unchanged.
