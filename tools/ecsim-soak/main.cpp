@@ -43,10 +43,14 @@ int main(int argc, char** argv) {
   app.add_option("--wait-ready-ms", waitReadyMs, "Probe this long for the server's first answer")
       ->check(CLI::Range(0u, 600000u));
   app.add_option("--errors-shown", o.errorsShown, "Print details of the first N errors");
+  unsigned progressS = 0;
+  app.add_option("--progress-s", progressS, "Print a progress line every N seconds (0: none)")
+      ->check(CLI::Range(0u, 86400u));
   CLI11_PARSE(app, argc, argv);
   o.timeout = std::chrono::milliseconds(timeoutMs);
   o.waitReady = std::chrono::milliseconds(waitReadyMs);
   o.escType = static_cast<std::uint8_t>(escType);
+  o.progress = std::chrono::seconds(progressS);
 
   auto link = ecsim::RawSocketLink::open(iface, ecsim::RawSocketOptions{netns, true});
   if (!link.ok()) {

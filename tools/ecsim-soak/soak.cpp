@@ -130,6 +130,7 @@ class Run {
     FrameSource source(options_.seed, net_, options_.malformedPercent);
     const auto start = Clock::now();
     auto nextWatch = start + kWatchInterval;
+    auto nextProgress = start + options_.progress;
     SoakFrame next;
     bool pending = false;
     while (!report_.serverDied) {
@@ -142,6 +143,14 @@ class Run {
           error("the server process has ended");
           break;
         }
+      }
+      if (options_.progress.count() > 0 && now >= nextProgress) {
+        nextProgress = now + options_.progress;
+        fmt::print(log_, "ecsim-soak: {:.0f} s: {} frames sent, {} answered, {} timeouts, {} errors\n",
+                   std::chrono::duration<double>(now - start).count(), report_.sent,
+                   report_.answered, report_.timeouts,
+                   report_.wkcErrors + report_.dataErrors + report_.malformedAnswered);
+        std::fflush(log_);
       }
       if (report_.sent < options_.frames) {
         if (!pending) {

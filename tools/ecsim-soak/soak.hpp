@@ -27,6 +27,7 @@ struct SoakOptions {
   pid_t serverPid{0};          // 0: not watched
   std::chrono::milliseconds waitReady{0};  // keep probing this long for a first answer
   unsigned errorsShown{10};    // details printed for the first N errors
+  std::chrono::seconds progress{0};  // a progress line this often (0: none)
 };
 
 struct SoakReport {
