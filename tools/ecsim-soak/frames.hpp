@@ -116,8 +116,8 @@ class FrameSource {
   std::uint32_t malformedCount_{0};
 };
 
-// Checks an answer to a valid frame against the datasheet expectations. Returns an empty
-// string when everything holds, else what differed (first difference only).
+// Checks an answer to a valid frame against the datasheet expectations: no error flag and an
+// empty `what` when everything holds, else the first difference.
 struct CheckResult {
   bool wkcError{false};
   bool dataError{false};
