@@ -5,8 +5,8 @@
 #   <prefix>/lib/libecsim_*.a
 #   <prefix>/lib/cmake/ecsim/ecsimConfig.cmake (+ version, exported targets)
 #   <prefix>/lib/pkgconfig/ecsim.pc
-#   <prefix>/bin/ecsim, ecmaster and <prefix>/share/ecsim/{esi,topologies} (installed by
-#   tools/ecsim and tools/ecmaster), <prefix>/share/ecsim/examples/user-project
+#   <prefix>/bin/ecsim, ecmaster, ecsim-soak and <prefix>/share/ecsim/{esi,topologies} (installed by
+#   tools/ecsim, tools/ecmaster, tools/ecsim-soak), <prefix>/share/ecsim/examples/user-project
 #
 # Headers keep the source layout under include/ecsim, and include/ecsim is an include
 # directory of every exported target, so installed code includes "protocol/result.hpp"
@@ -82,7 +82,7 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/examples/user-project
 # before installing it (a no-op after a full build).
 add_custom_target(ecsim_install_deps)
 add_dependencies(ecsim_install_deps ${ecsim_install_targets})
-foreach(tool ecsim ecmaster)
+foreach(tool ecsim ecmaster ecsim-soak)
   if(TARGET ${tool})
     add_dependencies(ecsim_install_deps ${tool})
   endif()
