@@ -3,11 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
-#include <iterator>
 #include <regex>
-#include <sstream>
 
+#include "protocol/read_file.hpp"
 #include "scenario/scenario.hpp"
 
 namespace ecsim::scenario {
@@ -102,6 +100,7 @@ Result<TimedAction> readAction(const Reader& r, const XMLElement* e) {
   if (!runnerVerb && !topology::FaultInjector::handles(a.action.verb)) {
     return r.error(e, "unknown action \"" + a.action.verb + "\"");
   }
+  if (!runnerVerb) ECSIM_TRY(topology::checkFaultArguments(a.action));
   return a;
 }
 
@@ -291,11 +290,8 @@ bool compareValues(double observed, Compare c, double expected, double tolerance
 }
 
 Result<Scenario> loadScenario(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return makeError(ErrorCode::kIo, path.string() + ": cannot open");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return parseScenario(buffer.str(), path);
+  ECSIM_ASSIGN_OR_RETURN(const std::string text, readRegularFile(path, kMaxXmlFileBytes));
+  return parseScenario(text, path);
 }
 
 Result<Scenario> parseScenario(std::string_view xml, const std::filesystem::path& path) {
