@@ -7,6 +7,8 @@
 
 #include "config/xml_util.hpp"
 #include "protocol/frame.hpp"  // kMaxSlaves
+#include "config/xml_util.hpp"
+#include "protocol/read_file.hpp"
 
 namespace ecsim {
 namespace {
@@ -383,19 +385,12 @@ Result<EniConfig> parseEni(std::string_view text, const std::filesystem::path& f
 }
 
 Result<EniConfig> loadEniFile(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return makeError(ErrorCode::kNotFound, path.string() + ": cannot open ENI file");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return parseEni(buffer.str(), path);
+  ECSIM_ASSIGN_OR_RETURN(const std::string text, readRegularFile(path, kMaxXmlFileBytes));
+  return parseEni(text, path);
 }
 
 Result<std::string> xmlRootName(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return makeError(ErrorCode::kNotFound, path.string() + ": cannot open");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  const std::string text = buffer.str();
+  ECSIM_ASSIGN_OR_RETURN(const std::string text, readRegularFile(path, kMaxXmlFileBytes));
   const Context ctx(path.string());
   tinyxml2::XMLDocument doc;
   ECSIM_TRY(xml::parseDocument(text, ctx, doc));

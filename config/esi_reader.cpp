@@ -1,8 +1,7 @@
 // ESI reader: roots, vendor, groups, devices, modules and slots.
-#include <fstream>
-#include <iterator>
 
 #include "config/esi_parts.hpp"
+#include "protocol/read_file.hpp"
 
 namespace ecsim {
 namespace {
@@ -378,10 +377,7 @@ Result<EsiFile> parseEsi(std::string_view xmlText, std::string_view fileName) {
 }
 
 Result<EsiFile> loadEsiFile(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return makeError(ErrorCode::kIo, path.string() + ": cannot open");
-  std::string content{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (in.bad()) return makeError(ErrorCode::kIo, path.string() + ": read failed");
+  ECSIM_ASSIGN_OR_RETURN(const std::string content, readRegularFile(path, kMaxXmlFileBytes));
   return parseEsi(content, path.string());
 }
 

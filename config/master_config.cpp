@@ -4,11 +4,10 @@
 #include <tinyxml2.h>
 
 #include <cstdio>
-#include <fstream>
-#include <sstream>
 
 #include "config/eni.hpp"
 #include "config/esi.hpp"
+#include "protocol/read_file.hpp"
 
 namespace ecsim {
 namespace {
@@ -86,11 +85,7 @@ MasterConfig masterConfigFromEni(EniConfig eni) {
 }
 
 Result<MasterConfig> loadMasterConfig(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return makeError(ErrorCode::kIo, path.string() + ": cannot be read");
-  std::ostringstream text;
-  text << in.rdbuf();
-  const std::string xml = text.str();
+  ECSIM_ASSIGN_OR_RETURN(const std::string xml, readRegularFile(path, kMaxXmlFileBytes));
   tinyxml2::XMLDocument doc;
   const bool parsed = doc.Parse(xml.data(), xml.size()) == tinyxml2::XML_SUCCESS;
   if (parsed && doc.RootElement() != nullptr &&

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "config/xml_util.hpp"
+#include "protocol/read_file.hpp"
 
 namespace ecsim {
 namespace {
@@ -208,11 +209,8 @@ Result<TopologyConfig> parseTopology(std::string_view text, const std::filesyste
 }
 
 Result<TopologyConfig> loadTopologyFile(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return makeError(ErrorCode::kNotFound, path.string() + ": cannot open topology file");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return parseTopology(buffer.str(), path);
+  ECSIM_ASSIGN_OR_RETURN(const std::string text, readRegularFile(path, kMaxXmlFileBytes));
+  return parseTopology(text, path);
 }
 
 }  // namespace ecsim

@@ -9,8 +9,8 @@
 #include <iterator>
 #include <limits>
 #include <regex>
-#include <sstream>
 
+#include "protocol/read_file.hpp"
 #include "scenario/scenario.hpp"
 
 namespace ecsim::scenario {
@@ -128,6 +128,7 @@ Result<TimedAction> readAction(const Reader& r, const XMLElement* e) {
   if (!runnerVerb && !topology::FaultInjector::handles(a.action.verb)) {
     return r.error(e, "unknown action \"" + a.action.verb + "\"");
   }
+  if (!runnerVerb) ECSIM_TRY(topology::checkFaultArguments(a.action));
   return a;
 }
 
@@ -318,11 +319,8 @@ bool compareValues(double observed, Compare c, double expected, double tolerance
 }
 
 Result<Scenario> loadScenario(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return makeError(ErrorCode::kIo, path.string() + ": cannot open");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return parseScenario(buffer.str(), path);
+  ECSIM_ASSIGN_OR_RETURN(const std::string text, readRegularFile(path, kMaxXmlFileBytes));
+  return parseScenario(text, path);
 }
 
 Result<Scenario> parseScenario(std::string_view xml, const std::filesystem::path& path) {

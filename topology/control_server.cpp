@@ -1,18 +1,22 @@
 #include "topology/control_server.hpp"
 
 #include <fcntl.h>
+#include <poll.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 
 namespace ecsim::topology {
 namespace {
 
-constexpr std::size_t kMaxLine = 4096;
+constexpr std::size_t kReadPerPoll = 64 * 1024;  // per client, so a flood cannot hold the loop
+constexpr std::size_t kAcceptsPerPoll = 64;
+constexpr int kConnectRetryMs = 10;
 
 Result<sockaddr_un> socketAddress(const std::filesystem::path& path) {
   sockaddr_un addr{};
@@ -25,17 +29,36 @@ Result<sockaddr_un> socketAddress(const std::filesystem::path& path) {
   return addr;
 }
 
-void sendAll(int fd, std::string_view text) {
-  while (!text.empty()) {
-    const ssize_t n = ::send(fd, text.data(), text.size(), MSG_NOSIGNAL);
-    if (n <= 0) return;
-    text.remove_prefix(static_cast<std::size_t>(n));
+// Sends what the socket takes now; removes it from `text`. False on a broken connection.
+bool sendSome(int fd, std::string& text) {
+  std::size_t sent = 0;
+  bool alive = true;
+  while (sent < text.size()) {
+    const ssize_t n =
+        ::send(fd, text.data() + sent, text.size() - sent, MSG_NOSIGNAL | MSG_DONTWAIT);
+    if (n > 0) {
+      sent += static_cast<std::size_t>(n);
+    } else if (n < 0 && errno == EINTR) {
+      continue;
+    } else {
+      alive = n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK);
+      break;
+    }
   }
+  text.erase(0, sent);
+  return alive;
+}
+
+// Waits until `fd` is writable or `timeout` passes.
+bool waitWritable(int fd, std::chrono::milliseconds timeout) {
+  pollfd pfd{fd, POLLOUT, 0};
+  return ::poll(&pfd, 1, static_cast<int>(timeout.count())) > 0 && (pfd.revents & POLLOUT) != 0;
 }
 
 }  // namespace
 
-Result<ControlServer> ControlServer::open(const std::filesystem::path& path) {
+Result<ControlServer> ControlServer::open(const std::filesystem::path& path,
+                                          ControlLimits limits) {
   std::error_code ec;
   const auto dir = path.parent_path();
   if (!dir.empty() && !std::filesystem::exists(dir, ec)) {
@@ -59,7 +82,7 @@ Result<ControlServer> ControlServer::open(const std::filesystem::path& path) {
   if (::listen(fd.get(), 8) != 0) {
     return makeError(ErrorCode::kIo, path.string() + ": listen: " + errnoText(errno));
   }
-  return ControlServer(std::move(fd), path);
+  return ControlServer(std::move(fd), path, limits);
 }
 
 ControlServer::ControlServer(ControlServer&&) noexcept = default;
@@ -69,40 +92,80 @@ ControlServer::~ControlServer() {
   if (fd_.valid()) ::unlink(path_.c_str());
 }
 
-void ControlServer::poll(const Handler& handler) {
-  while (true) {
+void ControlServer::poll(const Handler& handler, SimTime now) {
+  accept(now);
+  for (auto it = clients_.begin(); it != clients_.end();) {
+    if (serve(*it, handler, now)) {
+      ++it;
+    } else {
+      it = clients_.erase(it);
+    }
+  }
+}
+
+void ControlServer::accept(SimTime now) {
+  for (std::size_t n = 0; n < kAcceptsPerPoll; ++n) {
     UniqueFd client(::accept4(fd_.get(), nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC));
     if (!client.valid()) break;
-    clients_.push_back({std::move(client), {}});
+    if (clients_.size() >= limits_.maxClients) {
+      std::string refusal =
+          "error too many clients (" + std::to_string(limits_.maxClients) + ")\n";
+      (void)sendSome(client.get(), refusal);
+      continue;  // closed here
+    }
+    Client c;
+    c.fd = std::move(client);
+    c.lastHeard = now;
+    clients_.push_back(std::move(c));
   }
-  for (auto it = clients_.begin(); it != clients_.end();) {
-    char buf[512];
-    bool done = false;
-    while (true) {
-      const ssize_t n = ::recv(it->fd.get(), buf, sizeof(buf), 0);
-      if (n > 0) {
-        it->buffer.append(buf, static_cast<std::size_t>(n));
-        if (it->buffer.size() > kMaxLine) {
-          sendAll(it->fd.get(), "error request line too long\n");
-          done = true;
-          break;
-        }
-        continue;
-      }
-      if (n == 0) done = true;  // closed by the client
-      break;                    // EAGAIN: nothing more now
+}
+
+bool ControlServer::serve(Client& c, const Handler& handler, SimTime now) {
+  if (!sendSome(c.fd.get(), c.reply)) return false;
+  std::size_t budget = kReadPerPoll;
+  char buf[4096];
+  // While the client leaves its answers unread, its further lines wait in the socket.
+  while (!c.closing && c.reply.size() < kControlMaxPendingReply && budget > 0) {
+    const ssize_t n = ::recv(c.fd.get(), buf, std::min(sizeof(buf), budget), 0);
+    if (n > 0) {
+      c.lastHeard = now;
+      budget -= static_cast<std::size_t>(n);
+      takeLines(c, std::string_view(buf, static_cast<std::size_t>(n)), handler);
+      if (!sendSome(c.fd.get(), c.reply)) return false;
+      continue;
     }
-    std::size_t nl;
-    while (!it->buffer.empty() && (nl = it->buffer.find('\n')) != std::string::npos) {
-      const std::string line = it->buffer.substr(0, nl);
-      it->buffer.erase(0, nl + 1);
-      sendAll(it->fd.get(), handler(line) + "\n");
+    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)) break;
+    c.closing = true;  // closed by the client (its lines are answered), or broken
+  }
+  if (c.closing && c.reply.empty()) return false;
+  if (now - c.lastHeard > limits_.idleTimeout) {
+    std::string bye = "error nothing received for " +
+                      std::to_string(limits_.idleTimeout / kNsPerSecond) + " s: closed\n";
+    (void)sendSome(c.fd.get(), bye);
+    return false;
+  }
+  return true;
+}
+
+void ControlServer::takeLines(Client& c, std::string_view data, const Handler& handler) {
+  while (!data.empty()) {
+    const std::size_t nl = data.find('\n');
+    const std::string_view piece = data.substr(0, nl);
+    data.remove_prefix(nl == std::string_view::npos ? data.size() : nl + 1);
+    if (c.discarding) {
+      c.discarding = nl == std::string_view::npos;
+      continue;
     }
-    if (done) {
-      it = clients_.erase(it);
-    } else {
-      ++it;
+    if (c.buffer.size() + piece.size() > kControlMaxLine) {
+      c.reply += "error line longer than " + std::to_string(kControlMaxLine) + " bytes\n";
+      c.buffer.clear();
+      c.discarding = nl == std::string_view::npos;
+      continue;
     }
+    c.buffer.append(piece);
+    if (nl == std::string_view::npos) return;
+    c.reply += handler(c.buffer) + "\n";
+    c.buffer.clear();
   }
 }
 
@@ -110,12 +173,33 @@ Result<std::string> sendControlLine(const std::filesystem::path& path, std::stri
                                     std::chrono::milliseconds timeout) {
   auto addr = socketAddress(path);
   if (!addr.ok()) return addr.takeError();
-  UniqueFd fd(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0));
+  UniqueFd fd(::socket(AF_UNIX, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0));
   if (!fd.valid()) return makeError(ErrorCode::kIo, "socket: " + errnoText(errno));
-  if (::connect(fd.get(), reinterpret_cast<const sockaddr*>(&*addr), sizeof(*addr)) != 0) {
-    return makeError(ErrorCode::kIo, path.string() + ": connect: " + errnoText(errno));
+  // A Unix socket does not connect in the background: while the server's listen queue is full
+  // connect() answers EAGAIN at once, so it is tried again every few milliseconds until the
+  // timeout (counted in tries: no clock is read here).
+  const long tries = std::max<long>(1, static_cast<long>(timeout.count()) / kConnectRetryMs);
+  for (long attempt = 1;; ++attempt) {
+    if (::connect(fd.get(), reinterpret_cast<const sockaddr*>(&*addr), sizeof(*addr)) == 0) break;
+    if (errno != EAGAIN && errno != EINTR) {
+      return makeError(ErrorCode::kIo, path.string() + ": connect: " + errnoText(errno));
+    }
+    if (attempt >= tries) {
+      return makeError(ErrorCode::kTimeout,
+                       path.string() + ": the server accepted no connection within " +
+                           std::to_string(timeout.count()) + " ms (busy or full)");
+    }
+    ::poll(nullptr, 0, kConnectRetryMs);
   }
-  sendAll(fd.get(), std::string(line) + "\n");
+  std::string request = std::string(line) + "\n";
+  while (!request.empty()) {
+    if (!waitWritable(fd.get(), timeout)) {
+      return makeError(ErrorCode::kTimeout, path.string() + ": the server takes no request");
+    }
+    if (!sendSome(fd.get(), request)) {
+      return makeError(ErrorCode::kIo, path.string() + ": send: " + errnoText(errno));
+    }
+  }
   std::string reply;
   while (reply.find('\n') == std::string::npos) {
     auto readable = waitReadable(fd.get(), timeout);
@@ -123,6 +207,7 @@ Result<std::string> sendControlLine(const std::filesystem::path& path, std::stri
     if (!*readable) return makeError(ErrorCode::kTimeout, path.string() + ": no reply");
     char buf[512];
     const ssize_t n = ::recv(fd.get(), buf, sizeof(buf), 0);
+    if (n < 0 && (errno == EAGAIN || errno == EINTR)) continue;
     if (n <= 0) break;
     reply.append(buf, static_cast<std::size_t>(n));
   }

@@ -3,9 +3,17 @@
 // text form of topology/faults.hpp ("link-down cable=drives") and answers one line, "ok ..."
 // or "error ...". poll() never blocks: the serve loop calls it between frames, so an action
 // takes effect between two frames as on a real cable.
+//
+// Limits: at most kControlMaxClients clients at a time (one more is told "error too many
+// clients (N)" and closed); a client that sends nothing for the idle timeout is closed; a line
+// longer than kControlMaxLine bytes is answered "error line longer than N bytes" and discarded
+// up to its newline, the connection goes on. Every complete line is answered, in order; while
+// a client does not read its answers (more than kControlMaxPendingReply bytes waiting), its
+// further lines wait in the socket.
 #pragma once
 
 #include <chrono>
+#include <cstddef>
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -13,8 +21,19 @@
 
 #include "link/fd.hpp"
 #include "protocol/result.hpp"
+#include "protocol/time.hpp"
 
 namespace ecsim::topology {
+
+inline constexpr std::size_t kControlMaxClients = 8;
+inline constexpr std::size_t kControlMaxLine = 4096;  // bytes, without the newline
+inline constexpr std::size_t kControlMaxPendingReply = 64 * 1024;
+inline constexpr SimTime kControlIdleTimeout = 60 * kNsPerSecond;
+
+struct ControlLimits {
+  std::size_t maxClients{kControlMaxClients};
+  SimTime idleTimeout{kControlIdleTimeout};
+};
 
 class ControlServer {
  public:
@@ -23,28 +42,41 @@ class ControlServer {
 
   // Creates the socket at `path` (a stale socket file there is replaced; the directory is
   // created with mode 0700 when missing).
-  static Result<ControlServer> open(const std::filesystem::path& path);
+  static Result<ControlServer> open(const std::filesystem::path& path, ControlLimits limits = {});
   ControlServer(ControlServer&&) noexcept;
   ControlServer& operator=(ControlServer&&) noexcept;
   ~ControlServer();  // removes the socket file
 
-  // Accepts waiting clients, reads complete lines, answers them. Never blocks.
-  void poll(const Handler& handler);
+  // Accepts waiting clients, reads complete lines, answers them, closes clients idle since
+  // before `now - idleTimeout` (`now` from the caller's clock). Never blocks.
+  void poll(const Handler& handler, SimTime now);
   const std::filesystem::path& path() const { return path_; }
+  std::size_t clients() const { return clients_.size(); }
 
  private:
-  ControlServer(UniqueFd fd, std::filesystem::path path)
-      : fd_(std::move(fd)), path_(std::move(path)) {}
+  ControlServer(UniqueFd fd, std::filesystem::path path, ControlLimits limits)
+      : fd_(std::move(fd)), path_(std::move(path)), limits_(limits) {}
   struct Client {
     UniqueFd fd;
-    std::string buffer;
+    std::string buffer;      // the start of a line not yet complete
+    std::string reply;       // answers not yet taken by the client
+    bool discarding{false};  // inside a line over the limit: dropped up to its newline
+    bool closing{false};     // the client closed its side, or must be closed
+    SimTime lastHeard{0};
   };
+  void accept(SimTime now);
+  // Reads what the client sent and answers its complete lines; false when it is to be closed.
+  bool serve(Client& client, const Handler& handler, SimTime now);
+  void takeLines(Client& client, std::string_view data, const Handler& handler);
+
   UniqueFd fd_;
   std::filesystem::path path_;
+  ControlLimits limits_;
   std::vector<Client> clients_;
 };
 
-// Client side (`ecsim ctl`): sends one line, waits up to `timeout` for the reply line.
+// Client side (`ecsim ctl`): connects (giving up after `timeout` when the server does not
+// accept), sends one line, waits up to `timeout` for the reply line.
 Result<std::string> sendControlLine(const std::filesystem::path& path, std::string_view line,
                                     std::chrono::milliseconds timeout);
 

@@ -7,6 +7,7 @@
 #include <charconv>
 
 #include "protocol/al_status.hpp"
+#include "protocol/closest_name.hpp"
 #include "protocol/mailbox.hpp"
 #include "protocol/sdo.hpp"
 #include "slavesim/devices/device_models.hpp"
@@ -20,10 +21,40 @@ constexpr std::size_t kSiiChecksumByte = 14;  // word 7, low byte: CRC-8 of word
 constexpr std::uint16_t kOvercurrent = 0x2310;
 constexpr std::uint16_t kPositionSensorFault = 0x7305;
 
-constexpr std::array<std::string_view, 17> kVerbs{
-    "loss",        "corrupt",       "delay",           "link-down",      "link-up",   "power-off",
-    "power-on",    "al-error",      "eeprom-checksum", "mailbox-silent", "sdo-abort", "sdo-ok",
-    "drive-fault", "encoder-fault", "input",           "power-cycle",    "mailbox-ok"};
+// ---- The verbs and the arguments each takes (checkFaultArguments) --------------------------
+// Keys in alphabetical order; a verb has at most kMaxVerbKeys.
+constexpr std::size_t kMaxVerbKeys = 5;
+struct VerbArguments {
+  std::string_view verb;
+  std::array<std::string_view, kMaxVerbKeys> keys;
+};
+constexpr std::array<VerbArguments, 17> kVerbArguments{{
+    {"loss", {"cable", "rate"}},
+    {"corrupt", {"cable", "count", "port", "slave"}},
+    {"delay", {"cable", "durationMs", "ns", "port", "slave"}},
+    {"link-down", {"cable", "port", "slave"}},
+    {"link-up", {"cable", "port", "slave"}},
+    {"power-off", {"slave"}},
+    {"power-on", {"slave"}},
+    {"power-cycle", {"slave"}},
+    {"al-error", {"code", "slave", "state"}},
+    {"eeprom-checksum", {"slave"}},
+    {"mailbox-silent", {"on", "slave"}},
+    {"mailbox-ok", {"on", "slave"}},
+    {"sdo-abort", {"code", "index", "slave", "sub"}},
+    {"sdo-ok", {"slave"}},
+    {"drive-fault", {"code", "slave"}},
+    {"encoder-fault", {"channel", "kind", "on", "slave"}},
+    {"input", {"channel", "signal", "slave"}},
+}};
+
+const VerbArguments* verbArguments(std::string_view verb) {
+  for (const auto& v : kVerbArguments) {
+    if (v.verb == verb) return &v;
+  }
+  return nullptr;
+}
+// ---- end of the verb table ------------------------------------------------------------------
 
 std::optional<AlState> stateFromName(std::string_view name) {
   if (name == "INIT") return AlState::kInit;
@@ -198,45 +229,75 @@ std::string FaultAction::text() const {
   return out;
 }
 
+Status checkFaultArguments(const FaultAction& action) {
+  const VerbArguments* verb = verbArguments(action.verb);
+  if (verb == nullptr) {
+    std::vector<std::string_view> verbs;
+    for (const auto& v : kVerbArguments) verbs.push_back(v.verb);
+    return makeError(ErrorCode::kInvalidArgument,
+                     (action.where.empty() ? std::string() : action.where + ": ") +
+                         unknownNameText("action", action.verb, verbs));
+  }
+  std::vector<std::string_view> keys;
+  for (std::string_view k : verb->keys) {
+    if (!k.empty()) keys.push_back(k);
+  }
+  for (const auto& [key, value] : action.args) {
+    if (std::find(keys.begin(), keys.end(), key) == keys.end()) {
+      return action.error(unknownNameText("argument", key, keys));
+    }
+  }
+  return okStatus();
+}
+
 Result<FaultAction> parseFaultAction(std::string_view line) {
+  auto fail = [](std::size_t at, const std::string& what) {
+    return makeError(ErrorCode::kParse, fmt::format("control: column {}: {}", at + 1, what));
+  };
+  if (!line.empty() && line.back() == '\r') line.remove_suffix(1);  // CR LF (nc -C, telnet)
+  for (std::size_t k = 0; k < line.size(); ++k) {
+    const auto c = static_cast<unsigned char>(line[k]);
+    if ((c < 0x20 && c != '\t') || c == 0x7F) {
+      return fail(k, fmt::format("byte {:#04x} is not printable", c));
+    }
+  }
+  const auto isSpace = [](char c) { return c == ' ' || c == '\t'; };
   FaultAction action;
   action.where = "control";
   std::size_t i = 0;
   auto skipSpace = [&] {
-    while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
+    while (i < line.size() && isSpace(line[i])) ++i;
   };
   skipSpace();
   std::size_t start = i;
-  while (i < line.size() && line[i] != ' ' && line[i] != '\t') ++i;
+  while (i < line.size() && !isSpace(line[i])) ++i;
   action.verb = std::string(line.substr(start, i - start));
   if (action.verb.empty()) return makeError(ErrorCode::kParse, "control: empty action");
   while (true) {
     skipSpace();
     if (i >= line.size()) break;
     start = i;
-    while (i < line.size() && line[i] != '=' && line[i] != ' ') ++i;
-    if (i >= line.size() || line[i] != '=') {
-      return makeError(ErrorCode::kParse,
-                       fmt::format("control: column {}: expected key=value", start + 1));
-    }
+    while (i < line.size() && line[i] != '=' && !isSpace(line[i])) ++i;
+    if (i >= line.size() || line[i] != '=') return fail(start, "expected key=value");
+    if (i == start) return fail(start, "empty argument name");
     std::string key(line.substr(start, i - start));
     ++i;
     std::string value;
     if (i < line.size() && line[i] == '"') {
       const std::size_t close = line.find('"', i + 1);
-      if (close == std::string_view::npos) {
-        return makeError(ErrorCode::kParse,
-                         fmt::format("control: column {}: unterminated quote", i + 1));
-      }
+      if (close == std::string_view::npos) return fail(i, "unterminated quote");
       value = std::string(line.substr(i + 1, close - i - 1));
       i = close + 1;
     } else {
-      start = i;
-      while (i < line.size() && line[i] != ' ' && line[i] != '\t' && line[i] != '\r') ++i;
-      value = std::string(line.substr(start, i - start));
+      const std::size_t from = i;
+      while (i < line.size() && !isSpace(line[i])) ++i;
+      value = std::string(line.substr(from, i - from));
     }
-    action.args[key] = value;
+    if (!action.args.emplace(key, std::move(value)).second) {
+      return fail(start, "argument '" + key + "' given twice");
+    }
   }
+  ECSIM_TRY(checkFaultArguments(action));
   return action;
 }
 
@@ -252,7 +313,7 @@ FaultInjector::~FaultInjector() {
 }
 
 bool FaultInjector::handles(std::string_view verb) {
-  return std::find(kVerbs.begin(), kVerbs.end(), verb) != kVerbs.end();
+  return verbArguments(verb) != nullptr;
 }
 
 Result<std::size_t> FaultInjector::slaveIndex(std::string_view name) const {

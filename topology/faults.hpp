@@ -98,8 +98,13 @@ struct FaultAction {
   std::string text() const;
 };
 
-// "verb key=value key="quoted value" ..." (a control line).
+// "verb key=value key="quoted value" ..." (a control line; a final CR is ignored). Refused,
+// naming the column: a byte that is not printable, an unterminated quote, an empty or repeated
+// argument name; and what checkFaultArguments refuses.
 Result<FaultAction> parseFaultAction(std::string_view line);
+// An unknown verb, or an argument the verb does not take, is an error naming the closest valid
+// name (or listing the valid ones).
+Status checkFaultArguments(const FaultAction& action);
 // Decimal or 0x-prefixed hexadecimal.
 std::optional<std::uint64_t> parseNumber(std::string_view text);
 

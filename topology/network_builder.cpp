@@ -4,6 +4,7 @@
 
 #include <fstream>
 
+#include "protocol/read_file.hpp"
 #include "protocol/sii.hpp"
 #include "slavesim/devices/device_params.hpp"
 #include "slavesim/esi_slave.hpp"
@@ -29,9 +30,9 @@ Error at(const TopologySlave& entry, std::string message) {
 // ESC with that image, its standard mailbox as the SII gives it, no application behind it.
 Result<std::unique_ptr<slavesim::Slave>> makeFromEeprom(const TopologySlave& entry,
                                                         const slavesim::EscType& esc) {
-  std::ifstream in(entry.eepromFile, std::ios::binary);
-  if (!in) return at(entry, "cannot read EEPROM image " + entry.eepromFile.string());
-  std::vector<std::uint8_t> image((std::istreambuf_iterator<char>(in)), {});
+  auto file = readRegularFile(entry.eepromFile, kMaxEepromFileBytes);
+  if (!file.ok()) return at(entry, "EEPROM image " + file.error().context);
+  std::vector<std::uint8_t> image(file->begin(), file->end());
   auto contents = SiiImage::parseLenient(image);
   slavesim::SlaveProfile profile;
   if (contents.ok() && contents->contents().standardMailbox.receiveSize > 0) {

@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <fstream>
 #include <map>
 #include <numbers>
+#include <sstream>
+
+#include "protocol/read_file.hpp"
 
 namespace ecsim::slavesim::devices {
 namespace {
@@ -89,8 +91,9 @@ Signal Signal::table(std::vector<Point> points, bool loop, bool step) {
 }
 
 Result<Signal> Signal::fromCsv(const std::filesystem::path& path, bool loop, bool step) {
-  std::ifstream in(path);
-  if (!in) return makeError(ErrorCode::kIo, path.string() + ": cannot open signal file");
+  // Read whole and at once: a FIFO or a device here would hold the serve loop (ecsim ctl input).
+  ECSIM_ASSIGN_OR_RETURN(const std::string content, readRegularFile(path, kMaxTextFileBytes));
+  std::istringstream in(content);
   std::vector<Point> points;
   std::string line;
   int lineNo = 0;

@@ -308,10 +308,10 @@ TEST(EsiReader, UnknownRootIsAnError) {
   EXPECT_NE(file.error().context.find("EtherCATConfig"), std::string::npos);
 }
 
-TEST(EsiReader, MissingFileIsAnIoError) {
+TEST(EsiReader, MissingFileIsNotFound) {
   auto file = loadEsiFile("/nonexistent/esi.xml");
   ASSERT_FALSE(file.ok());
-  EXPECT_EQ(file.error().code, ErrorCode::kIo);
+  EXPECT_EQ(file.error().code, ErrorCode::kNotFound);
 }
 
 // --- other roots, old-style PDO templates, encodings ----------------------------------------

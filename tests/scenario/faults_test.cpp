@@ -236,5 +236,42 @@ TEST(FaultArguments, CorruptCountsAddUpToTheBoundNotBeyond) {
   EXPECT_TRUE(net.segment->processFrame(frame, 0).delivered);
 }
 
+// The context of a refused control line ("" when it was accepted).
+std::string refusal(std::string_view line) {
+  auto a = parseFaultAction(line);
+  return a.ok() ? std::string() : a.error().context;
+}
+
+TEST(FaultAction, MalformedLinesAreRefusedWithTheColumn) {
+  EXPECT_EQ(refusal("link-down cable=\"drives"), "control: column 17: unterminated quote");
+  EXPECT_EQ(refusal("link-down =drives"), "control: column 11: empty argument name");
+  EXPECT_EQ(refusal("link-down cable=a cable=b"),
+            "control: column 19: argument 'cable' given twice");
+  EXPECT_EQ(refusal("link-down cable=dr\x01ves"),
+            "control: column 19: byte 0x01 is not printable");
+  EXPECT_EQ(refusal(std::string("link-down cable=dr\0ves", 22)),
+            "control: column 19: byte 0x00 is not printable");
+  EXPECT_EQ(refusal("link-down cable=drives\x7f"),
+            "control: column 23: byte 0x7f is not printable");
+  // A line ended by CR LF (nc -C, telnet) is fine.
+  EXPECT_EQ(refusal("link-down cable=drives\r"), "");
+  EXPECT_EQ(refusal("input slave=DI1 channel=1 signal=\"sine amplitude=5\"\r"), "");
+}
+
+TEST(FaultAction, UnknownNamesAreRefusedNamingTheClosestValidOne) {
+  EXPECT_EQ(refusal("link-down cable=drives extra=1"),
+            "control: link-down: unknown argument 'extra' (valid: cable, port, slave)");
+  EXPECT_EQ(refusal("delay cable=master ns=5 durationMS=10"),
+            "control: delay: unknown argument 'durationMS'; did you mean 'durationMs'?");
+  EXPECT_EQ(refusal("power-off slave=S1 port=1"),
+            "control: power-off: unknown argument 'port' (valid: slave)");
+  EXPECT_EQ(refusal("link-dwn cable=drives"),
+            "control: unknown action 'link-dwn'; did you mean 'link-down'?");
+  // Every verb's own arguments are accepted.
+  EXPECT_EQ(refusal("sdo-abort slave=S1 index=0x6040 sub=0 code=0x06020000"), "");
+  EXPECT_EQ(refusal("encoder-fault slave=S1 kind=frame on=0 channel=2"), "");
+  EXPECT_EQ(refusal("delay slave=S1 port=1 ns=100 durationMs=5"), "");
+}
+
 }  // namespace
 }  // namespace ecsim::topology

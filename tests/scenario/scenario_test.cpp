@@ -9,6 +9,7 @@
 
 #include "scenario/runner.hpp"
 #include "scenario/scenario.hpp"
+#include "support/fifo.hpp"
 
 namespace ecsim::scenario {
 namespace {
@@ -145,6 +146,33 @@ std::string slurp(const std::filesystem::path& p) {
   std::stringstream ss;
   ss << in.rdbuf();
   return ss.str();
+}
+
+// A scenario path that names a FIFO is refused at once (readRegularFile), not waited on.
+TEST(ScenarioFile, AFifoIsRefused) {
+  const auto fifo = std::filesystem::temp_directory_path() /
+                    ("ecsim-scenario-fifo-" + std::to_string(::getpid()) + ".xml");
+  ASSERT_TRUE(ecsim::testing::makeFifo(fifo));
+  auto s = ecsim::testing::readWithoutHanging(fifo, [&] { return loadScenario(fifo); });
+  std::filesystem::remove(fifo);
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.error().context, fifo.string() + ": is a FIFO, not a regular file");
+}
+
+// An Action attribute its verb does not take is an error naming the closest valid one (it was
+// ignored: a misspelt durationMs left the fault in place for ever).
+TEST(ScenarioFile, AnArgumentTheActionDoesNotTakeIsAnError) {
+  auto s = parseScenario(
+      "<Scenario name=\"x\" topology=\"t.xml\" cycleUs=\"1000\" durationMs=\"100\">\n"
+      "  <Master kind=\"in-process\"/>\n"
+      "  <Timeline>\n"
+      "    <Action cycle=\"1\" do=\"delay\" cable=\"master\" ns=\"10\" durationMS=\"5\"/>\n"
+      "  </Timeline>\n"
+      "</Scenario>\n",
+      "/x/s.xml");
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.error().context,
+            "/x/s.xml, line 4: delay: unknown argument 'durationMS'; did you mean 'durationMs'?");
 }
 
 TEST(Runner, SameSeedSameReportAndCapture) {

@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "slavesim/devices/device_models.hpp"
+#include "support/fifo.hpp"
 #include "tests/slavesim/drive_test_support.hpp"
 
 namespace ecsim::testing {
@@ -97,7 +98,21 @@ TEST_F(SignalFiles, CsvWithHeaderAndComments) {
   auto back = dev::Signal::fromCsv(dir_ / "back.csv");
   ASSERT_FALSE(back.ok());
   EXPECT_NE(back.error().context.find("back.csv:3: time goes backwards"), std::string::npos);
-  EXPECT_EQ(dev::Signal::fromCsv(dir_ / "none.csv").error().code, ErrorCode::kIo);
+  EXPECT_EQ(dev::Signal::fromCsv(dir_ / "none.csv").error().code, ErrorCode::kNotFound);
+}
+
+// `ecsim ctl input ... signal="csv file=PATH"` is read by the single serve loop: a FIFO there
+// must be refused at once, not wait for a writer (and a device must not be read without end).
+TEST_F(SignalFiles, CsvThatIsAFifoOrADeviceIsRefusedWithoutBlocking) {
+  const auto fifo = dir_ / "trace.csv";
+  ASSERT_TRUE(ecsim::testing::makeFifo(fifo));
+  auto s = ecsim::testing::readWithoutHanging(
+      fifo, [&] { return dev::parseSignal("csv file=" + fifo.string()); });
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.error().context, fifo.string() + ": is a FIFO, not a regular file");
+  auto zero = dev::parseSignal("csv file=/dev/zero");
+  ASSERT_FALSE(zero.ok());
+  EXPECT_EQ(zero.error().context, "/dev/zero: is a character device, not a regular file");
 }
 
 TEST_F(SignalFiles, TextForms) {

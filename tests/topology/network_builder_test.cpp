@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include "support/fifo.hpp"
 #include "support/test_network.hpp"
 
 namespace ecsim::testing {
@@ -63,6 +64,33 @@ TEST(NetworkBuilder, MoreSlavesThanTheAddressSpaceAreRefused) {
   ASSERT_FALSE(net.ok());
   EXPECT_NE(net.error().context.find("65536 slaves, more than 65535"), std::string::npos)
       << net.error().context;
+}
+
+// An EEPROM image must be a regular file of at most 1 MiB: a device or a FIFO named there is
+// refused with its path, not read without end or waited on.
+TEST(NetworkBuilder, EepromImageThatIsNotARegularFileIsRefused) {
+  auto zero = parseTopology("<Topology>\n<Slave name=\"E\" eeprom=\"/dev/zero\"/>\n</Topology>",
+                            "t.xml");
+  ASSERT_TRUE(zero.ok()) << zero.error().message();
+  auto net = topology::buildNetwork(*zero);
+  ASSERT_FALSE(net.ok());
+  EXPECT_NE(net.error().context.find("/dev/zero: is a character device, not a regular file"),
+            std::string::npos)
+      << net.error().context;
+
+  const auto fifo = std::filesystem::temp_directory_path() /
+                    ("ecsim-eeprom-fifo-" + std::to_string(::getpid()) + ".bin");
+  ASSERT_TRUE(makeFifo(fifo));
+  auto cfg = parseTopology("<Topology>\n<Slave name=\"E\" eeprom=\"" + fifo.string() +
+                               "\"/>\n</Topology>",
+                           "t.xml");
+  ASSERT_TRUE(cfg.ok()) << cfg.error().message();
+  auto built = readWithoutHanging(fifo, [&] { return topology::buildNetwork(*cfg); });
+  std::filesystem::remove(fifo);
+  ASSERT_FALSE(built.ok());
+  EXPECT_NE(built.error().context.find(fifo.string() + ": is a FIFO, not a regular file"),
+            std::string::npos)
+      << built.error().context;
 }
 
 }  // namespace

@@ -22,6 +22,13 @@ struct CtlOptions {
 int runCtl(const CtlOptions& o) {
   std::string line;
   for (const auto& w : o.words) {
+    // One request is one line: a newline in an argument would send a second action.
+    for (char c : w) {
+      if (c == '\n' || c == '\r') {
+        fmt::print(stderr, "ecsim ctl: argument '{}' holds a line break\n", w);
+        return 2;
+      }
+    }
     if (!line.empty()) line += ' ';
     // An argument whose value has spaces is sent quoted: signal="sine amplitude=5".
     const auto eq = w.find('=');
@@ -46,7 +53,10 @@ CommandRunner addCtlCommand(CLI::App& app) {
   auto opts = std::make_shared<CtlOptions>();
   auto* cmd = app.add_subcommand("ctl", "Send a fault action to a running `ecsim serve`");
   cmd->add_option("--socket", opts->socket, "Control socket of the server")->capture_default_str();
-  cmd->add_option("--timeout-ms", opts->timeoutMs, "How long to wait for the reply");
+  cmd->add_option("--timeout-ms", opts->timeoutMs,
+                  "How long to wait for the connection and for the reply")
+      ->check(CLI::Range(1u, 3'600'000u))
+      ->capture_default_str();
   cmd->add_option("action", opts->words, "ACTION [key=value ...] (docs/scenarios.md)")->required();
   return [opts] { return runCtl(*opts); };
 }

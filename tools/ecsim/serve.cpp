@@ -217,7 +217,7 @@ int runServe(ServeOptions o) {
     return done.ok() ? "ok " + *done : "error " + done.error().context;
   };
   auto status = server.run([&] {
-    if (control.ok()) control->poll(handle);
+    if (control.ok()) control->poll(handle, clock.now());
     reporter.tick(clock.now(), segment, server.counters());
     return stop.raised();
   });
