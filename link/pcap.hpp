@@ -18,6 +18,8 @@ namespace ecsim {
 
 constexpr int kLinkTypeEthernet = 1;  // LINKTYPE_ETHERNET / DLT_EN10MB
 constexpr int kPcapSnapLength = 65535;
+// Buffered records reach the file at least this often (by the caller's clock, flushIfDue).
+constexpr SimTime kCaptureFlushInterval = 100 * kNsPerMs;
 
 // Writes one capture file. Safe to share between threads (a sender and a receiver thread
 // recording through PcapTaps): each call holds an internal lock. Frames longer than the
@@ -34,6 +36,9 @@ class PcapWriter {
   // 2^32 seconds (the classic pcap range).
   Status write(ConstBytes frame, SimTime timestampNs);
   Status flush();
+  // Flushes when records have waited kCaptureFlushInterval since the last flush, by the
+  // caller's clock (`now`); the writer never reads a clock itself.
+  Status flushIfDue(SimTime now);
   // Flushes and closes; later writes fail with kState. Closing twice is fine.
   Status close();
 

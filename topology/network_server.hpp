@@ -20,6 +20,9 @@ struct ServerOptions {
   bool paced{false};
   // How long one step waits for a frame before running the slaves' firmware anyway.
   std::chrono::nanoseconds idleWait{std::chrono::milliseconds(1)};
+  // Sees every malformed frame the server drops, as received, stamped with the clock's time
+  // (`ecsim serve --pcap-malformed`). Not owned; null: none.
+  CableObserver* malformedObserver{nullptr};
 };
 
 struct ServerCounters {

@@ -127,6 +127,43 @@ TEST(PcapWriter, ReportsAnUnwritablePath) {
   EXPECT_NE(writer.error().context.find("/nonexistent-dir-ecsim/x.pcap"), std::string::npos);
 }
 
+// Captures you can trust after a crash: the header is on disk at open, buffered records reach
+// the file within kCaptureFlushInterval of the caller's clock, and only whole records do.
+TEST(PcapWriter, HeaderIsOnDiskAtOpen) {
+  TempPath file("header.pcap");
+  auto writer = PcapWriter::open(file.str());
+  ASSERT_TRUE(writer.ok()) << writer.error().message();
+  EXPECT_EQ(fileBytes(file.str()).size(), 24u) << "a capture killed before its first frame";
+}
+
+TEST(PcapWriter, FlushIfDueWritesWholeRecordsOnceTheIntervalHasPassed) {
+  TempPath file("due.pcap");
+  auto writer = PcapWriter::open(file.str());
+  ASSERT_TRUE(writer.ok()) << writer.error().message();
+  const SimTime t0 = 5 * kNsPerSecond;
+  ASSERT_TRUE(writer->flushIfDue(t0).ok());
+  ASSERT_TRUE(writer->write(etherCatFrame(1), 1).ok());
+  ASSERT_TRUE(writer->write(etherCatFrame(2), 2).ok());
+  ASSERT_TRUE(writer->flushIfDue(t0 + kCaptureFlushInterval - 1).ok());
+  EXPECT_EQ(fileBytes(file.str()).size(), 24u) << "not due yet: buffered";
+  ASSERT_TRUE(writer->flushIfDue(t0 + kCaptureFlushInterval).ok());
+  EXPECT_EQ(fileBytes(file.str()).size(), 24u + 2 * (16 + 60)) << "due: both records written";
+  // Whatever is on disk reads back whole, before close.
+  auto records = PcapReader::readAll(file.str());
+  ASSERT_TRUE(records.ok()) << records.error().message();
+  EXPECT_EQ(records->size(), 2u);
+}
+
+TEST(PcapWriter, FullDiskFailsAtOpenNamingTheFile) {
+  ECSIM_REQUIRE_OR_SKIP(std::filesystem::exists("/dev/full"), "no /dev/full");
+  auto writer = PcapWriter::open("/dev/full");
+  ASSERT_FALSE(writer.ok()) << "the header write must fail on a full device";
+  EXPECT_EQ(writer.error().code, ErrorCode::kIo);
+  EXPECT_NE(writer.error().context.find("/dev/full"), std::string::npos) << writer.error().context;
+  EXPECT_NE(writer.error().context.find("No space left"), std::string::npos)
+      << writer.error().context;
+}
+
 TEST(PcapReader, ReportsAMissingFile) {
   auto reader = PcapReader::open("/nonexistent-dir-ecsim/y.pcap");
   ASSERT_FALSE(reader.ok());
