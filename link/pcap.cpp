@@ -54,9 +54,9 @@ struct PcapWriter::Impl {
   Status flushLocked() {
     if (!failed.ok()) return failed;
     if (buffer.empty() || !fd.valid()) return okStatus();
-    Status written = writeAll(fd.get(), buffer,
-                              "writing capture file " + path + " (" +
-                                  std::to_string(bufferedFrames) + " frame(s) lost)");
+    Status written = writeAll(
+        fd.get(), buffer,
+        "writing capture file " + path + " (" + std::to_string(bufferedFrames) + " frame(s) lost)");
     buffer.clear();
     bufferedFrames = 0;
     if (!written.ok()) failed = written;
@@ -129,7 +129,8 @@ Status PcapWriter::write(ConstBytes frame, SimTime timestampNs) {
   writeLe32(buffer, at + 4, static_cast<std::uint32_t>(timestampNs % kNsPerSecond));
   writeLe32(buffer, at + 8, static_cast<std::uint32_t>(captured));
   writeLe32(buffer, at + 12, static_cast<std::uint32_t>(frame.size()));
-  std::copy_n(frame.begin(), captured, buffer.begin() + static_cast<long>(at + kPcapRecordHeaderSize));
+  std::copy_n(frame.begin(), captured,
+              buffer.begin() + static_cast<long>(at + kPcapRecordHeaderSize));
   ++impl_->bufferedFrames;
   ++impl_->frames;
   return okStatus();

@@ -1,9 +1,9 @@
 #include "link/raw_socket_link.hpp"
 
 #include <arpa/inet.h>
-#include <net/if.h>
 #include <linux/if_ether.h>   // ETH_P_ALL
 #include <linux/if_packet.h>  // tpacket_auxdata, besides what netpacket/packet.h has
+#include <net/if.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
 
@@ -184,10 +184,10 @@ Result<std::size_t> RawSocketLink::restoreVlanTag(const msghdr& message, Bytes b
     std::memcpy(&aux, CMSG_DATA(c), sizeof aux);
     if ((aux.tp_status & TP_STATUS_VLAN_VALID) == 0) return length;
     if (length < kEthernetHeaderSize || length + kVlanTagSize > buffer.size()) {
-      return makeError(ErrorCode::kTooLarge,
-                       describe() + ": VLAN-tagged frame of " +
-                           std::to_string(length + kVlanTagSize) + " bytes exceeds " +
-                           std::to_string(buffer.size()) + " bytes, frame dropped");
+      return makeError(ErrorCode::kTooLarge, describe() + ": VLAN-tagged frame of " +
+                                                 std::to_string(length + kVlanTagSize) +
+                                                 " bytes exceeds " + std::to_string(buffer.size()) +
+                                                 " bytes, frame dropped");
     }
     // The tag sits between the source address and the EtherType, as it was on the wire.
     constexpr std::size_t kTagAt = 2 * std::tuple_size_v<MacAddress>;

@@ -36,8 +36,8 @@ std::vector<std::string> inNs(const std::string& ns, std::vector<std::string> ar
 // The interface's index in namespace `ns` ("N: NAME..." from `ip -o link show`), kNotFound
 // when there is no interface of that name.
 Result<long> interfaceIndex(const std::string& ns, const std::string& ifname) {
-  ECSIM_ASSIGN_OR_RETURN(CommandOutput out, runCommand(inNs(ns, {"ip", "-o", "link", "show",
-                                                                 "dev", ifname})));
+  ECSIM_ASSIGN_OR_RETURN(CommandOutput out,
+                         runCommand(inNs(ns, {"ip", "-o", "link", "show", "dev", ifname})));
   long index = 0;
   const char* begin = out.output.data();
   const auto [end, ec] = std::from_chars(begin, begin + out.output.size(), index);
@@ -194,11 +194,11 @@ Status vethDown(const std::string& name, const VethSetupOptions& options) {
       // Deleting one end deletes the pair.
       (void)run(inNs(netns, {"ip", "link", "del", master}), false);
     } else {
-      status = makeError(ErrorCode::kState,
-                         "interfaces '" + master + "'/'" + simulator +
-                             "' are not the pair ecsim created (recorded indexes " +
-                             state["masterIndex"] + "/" + state["simulatorIndex"] +
-                             "): left alone");
+      status =
+          makeError(ErrorCode::kState, "interfaces '" + master + "'/'" + simulator +
+                                           "' are not the pair ecsim created (recorded indexes " +
+                                           state["masterIndex"] + "/" + state["simulatorIndex"] +
+                                           "): left alone");
     }
   }
   // Deleting our namespace deletes what is inside; a foreign interface moved into it meanwhile

@@ -22,6 +22,13 @@ bool linkExists(const VethNamespace& ns, const std::string& ifname) {
   return out.ok() && out->exitCode == 0;
 }
 
+// Runs a set-up command inside the namespace: "" when it succeeded, else what went wrong.
+std::string setUp(const VethNamespace& ns, const std::vector<std::string>& argv) {
+  auto out = ns.run(argv);
+  if (!out.ok()) return out.error().message();
+  return out->exitCode == 0 ? "" : out->output;
+}
+
 std::string uniqueName() {
   return "t" + std::to_string(::getpid() % 100000) + "x";
 }
@@ -60,9 +67,8 @@ TEST(NetSetup, UpAndServeVethRefuseAnExistingInterfaceAndLeaveIt) {
   auto ns = VethNamespace::create();
   ASSERT_TRUE(ns.ok()) << ns.error().message();
   const std::string name = uniqueName() + "e";
-  auto made = ns->run({"ip", "link", "add", name, "type", "veth", "peer", "name", name + "q"});
-  ASSERT_TRUE(made.ok());
-  ASSERT_EQ(made->exitCode, 0) << made->output;
+  ASSERT_EQ(setUp(*ns, {"ip", "link", "add", name, "type", "veth", "peer", "name", name + "q"}),
+            "");
   auto up = ns->run({kEcsim, "net", "up", name});
   ASSERT_TRUE(up.ok());
   EXPECT_NE(up->exitCode, 0) << up->output;
@@ -70,7 +76,8 @@ TEST(NetSetup, UpAndServeVethRefuseAnExistingInterfaceAndLeaveIt) {
   EXPECT_TRUE(linkExists(*ns, name)) << "a failed up deleted someone else's interface";
   EXPECT_TRUE(linkExists(*ns, name + "q")) << "a failed up deleted the peer";
   const std::string log = uniqueTempPath("serve_veth_" + name + ".log");
-  auto serve = ns->spawn({kEcsim, "serve", "--veth", name, "--slaves", "1"}, SpawnOptions{log, log});
+  auto serve =
+      ns->spawn({kEcsim, "serve", "--veth", name, "--slaves", "1"}, SpawnOptions{log, log});
   ASSERT_TRUE(serve.ok());
   auto code = serve->wait(kReadyTimeout);
   if (!code.ok()) (void)serve->stop();
@@ -86,9 +93,9 @@ TEST(NetSetup, UpAndServeVethRefuseAnExistingInterfaceAndLeaveIt) {
   EXPECT_TRUE(linkExists(*ns, name)) << "down removed an interface up never made";
   // The simulator's end NAMEs taken by someone else: refused the same way.
   const std::string other = uniqueName() + "f";
-  made = ns->run({"ip", "link", "add", other + "s", "type", "veth", "peer", "name", other + "q"});
-  ASSERT_TRUE(made.ok());
-  ASSERT_EQ(made->exitCode, 0) << made->output;
+  ASSERT_EQ(
+      setUp(*ns, {"ip", "link", "add", other + "s", "type", "veth", "peer", "name", other + "q"}),
+      "");
   up = ns->run({kEcsim, "net", "up", other});
   ASSERT_TRUE(up.ok());
   EXPECT_NE(up->exitCode, 0) << up->output;
@@ -108,12 +115,9 @@ TEST(NetSetup, DownLeavesAPairOfTheSameNameItDidNotCreate) {
   auto up = ns->run({kEcsim, "net", "up", name});
   ASSERT_TRUE(up.ok());
   ASSERT_EQ(up->exitCode, 0) << up->output;
-  auto del = ns->run({"ip", "link", "del", name});
-  ASSERT_TRUE(del.ok());
-  ASSERT_EQ(del->exitCode, 0) << del->output;
-  auto made = ns->run({"ip", "link", "add", name, "type", "veth", "peer", "name", name + "s"});
-  ASSERT_TRUE(made.ok());
-  ASSERT_EQ(made->exitCode, 0) << made->output;
+  ASSERT_EQ(setUp(*ns, {"ip", "link", "del", name}), "");
+  ASSERT_EQ(setUp(*ns, {"ip", "link", "add", name, "type", "veth", "peer", "name", name + "s"}),
+            "");
   auto down = ns->run({kEcsim, "net", "down", name});
   ASSERT_TRUE(down.ok());
   EXPECT_NE(down->exitCode, 0) << down->output;

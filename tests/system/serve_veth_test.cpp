@@ -33,6 +33,15 @@ std::string readText(const std::string& path) {
   return s.str();
 }
 
+// A tool the test needs (tshark, capinfos): missing is a failure under CI=true, else a skip.
+#define REQUIRE_TOOL(probe, tool)                                  \
+  do {                                                             \
+    if (!runCommand(probe).ok()) {                                 \
+      if (ciMode()) FAIL() << tool << " missing under CI=true";    \
+      GTEST_SKIP() << tool << " not installed (wireshark-common)"; \
+    }                                                              \
+  } while (false)
+
 // Waits for the end of `ecsim serve` after SIGINT: a bound against a hang, generous because a
 // sanitizer build on a busy machine is slow to finish and report.
 constexpr std::chrono::seconds kExitWait{30};
@@ -216,10 +225,7 @@ TEST(ServeVethRobustness, SurvivesTenThousandMalformedFrames) {
 
 TEST(ServeVethCapture, TsharkDecodesEveryFrameAsEtherCat) {
   ECSIM_REQUIRE_NETWORK();
-  if (!runCommand({"tshark", "--version"}).ok()) {
-    if (ciMode()) FAIL() << "tshark missing under CI=true";
-    GTEST_SKIP() << "tshark not installed";
-  }
+  REQUIRE_TOOL((std::vector<std::string>{"tshark", "--version"}), "tshark");
   auto ns = VethNamespace::create();
   ASSERT_TRUE(ns.ok()) << ns.error().message();
   const std::string pcap = uniqueTempPath("serve_capture.pcap");
@@ -282,7 +288,8 @@ TEST(ServeVethVlan, AnswersATaggedFrameWithTheSameTci) {
   ASSERT_TRUE(net.waitReady()) << readText(log);
   const std::uint16_t tci = 0xA00C;  // priority 5, VLAN 12
   std::array<std::uint8_t, kMaxFrameSize> buf{};
-  FrameBuilder b(buf, EthernetHeader{kBroadcastMac, {0x02, 0, 0, 0, 0, 7}, tci, kEtherTypeEtherCat});
+  FrameBuilder b(buf,
+                 EthernetHeader{kBroadcastMac, {0x02, 0, 0, 0, 0, 7}, tci, kEtherTypeEtherCat});
   ASSERT_TRUE(b.add(Command::kBrd, 0x5A, 0, std::vector<std::uint8_t>{0, 0}).ok());
   const auto len = b.finish();
   ASSERT_TRUE(len.ok());
@@ -353,10 +360,7 @@ TEST(ServeVethCapture, MalformedFramesGoToTheirOwnCapture) {
 // capinfos reads without error (it ended in a torn record before): whole records only.
 TEST(ServeVethCapture, SigkillDuringTrafficLeavesACaptureCapinfosReads) {
   ECSIM_REQUIRE_NETWORK();
-  if (!runCommand({"capinfos", "-h"}).ok()) {
-    if (ciMode()) FAIL() << "capinfos missing under CI=true";
-    GTEST_SKIP() << "capinfos not installed (wireshark-common)";
-  }
+  REQUIRE_TOOL((std::vector<std::string>{"capinfos", "-h"}), "capinfos");
   auto ns = VethNamespace::create();
   ASSERT_TRUE(ns.ok()) << ns.error().message();
   const std::string pcap = uniqueTempPath("serve_kill.pcap");
@@ -376,8 +380,8 @@ TEST(ServeVethCapture, SigkillDuringTrafficLeavesACaptureCapinfosReads) {
   const std::size_t beforeTraffic = recordsOnDisk();
   // Traffic, and SIGKILL in its middle.
   std::array<std::uint8_t, kMaxFrameSize> buf{};
-  FrameBuilder b(buf, EthernetHeader{kBroadcastMac, {0x02, 0, 0, 0, 0, 1}, std::nullopt,
-                                     kEtherTypeEtherCat});
+  FrameBuilder b(
+      buf, EthernetHeader{kBroadcastMac, {0x02, 0, 0, 0, 0, 1}, std::nullopt, kEtherTypeEtherCat});
   ASSERT_TRUE(b.add(Command::kBrd, 1, 0, std::vector<std::uint8_t>{0, 0}).ok());
   const auto len = b.finish();
   ASSERT_TRUE(len.ok());
@@ -404,8 +408,7 @@ TEST(ServeVethCapture, SigkillDuringTrafficLeavesACaptureCapinfosReads) {
   if (!records->empty() && killedAt > 0) {
     // A figure, not a pass/fail: how much before the kill the last record on disk was stamped.
     std::printf("capture after SIGKILL: %zu records, the last one %.1f ms before the kill\n",
-                records->size(),
-                static_cast<double>(killedAt - records->back().timestampNs) / 1e6);
+                records->size(), static_cast<double>(killedAt - records->back().timestampNs) / 1e6);
   }
   if (!HasFailure()) {
     std::filesystem::remove(pcap);

@@ -42,7 +42,7 @@ struct ServeOptions {
   std::string netns;
   std::string pcap;
   std::string pcapMalformed;  // malformed frames the simulator dropped, to their own capture
-  unsigned slaves{0};  // 0: not given
+  unsigned slaves{0};         // 0: not given
   bool paced{false};
   bool quiet{false};
   bool realtime{false};
