@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <unistd.h>
+
+#include <csignal>
 
 #include <array>
 #include <filesystem>
@@ -162,6 +165,48 @@ TEST(PcapWriter, FullDiskFailsAtOpenNamingTheFile) {
   EXPECT_NE(writer.error().context.find("/dev/full"), std::string::npos) << writer.error().context;
   EXPECT_NE(writer.error().context.find("No space left"), std::string::npos)
       << writer.error().context;
+}
+
+// A write error after open (here the file-size limit, as a full disk would) is reported by
+// the flush that meets it, names the file and the frames lost, and sticks: every later call
+// reports it, nothing is written past it.
+TEST(PcapWriter, AWriteErrorSticksAndNamesTheFile) {
+  TempPath file("efbig.pcap");
+  const int code = testing::runInChild([&]() -> int {
+    std::signal(SIGXFSZ, SIG_IGN);  // in the child only: the write fails with EFBIG instead
+    const rlimit limit{200, 200};
+    if (::setrlimit(RLIMIT_FSIZE, &limit) != 0) return 100;
+    auto writer = PcapWriter::open(file.str());
+    if (!writer.ok()) return 1;
+    for (std::uint8_t i = 0; i < 5; ++i) {
+      if (!writer->write(etherCatFrame(i), i).ok()) return 2;
+    }
+    auto flushed = writer->flush();
+    if (flushed.ok() || flushed.error().code != ErrorCode::kIo) return 3;
+    if (flushed.error().context.find(file.str()) == std::string::npos) return 4;
+    if (flushed.error().context.find("5 frame(s) lost") == std::string::npos) return 5;
+    if (writer->write(etherCatFrame(9), 9).ok()) return 6;
+    if (writer->flushIfDue(kNsPerSecond).ok() || writer->close().ok()) return 7;
+    return 0;
+  });
+  EXPECT_EQ(code, 0) << "1: open, 2: buffered write, 3: flush not kIo, 4: no path, 5: no count, "
+                        "6: write after error, 7: error not sticky";
+}
+
+// PcapTap flushes when a receive finds nothing waiting (the link is idle).
+TEST(PcapTap, AnIdleReceiveFlushes) {
+  TempPath file("tap_idle.pcap");
+  auto writer = PcapWriter::open(file.str());
+  ASSERT_TRUE(writer.ok());
+  auto [master, network] = MemoryLink::makePair(4);
+  VirtualClock clock(1'000);
+  PcapTap tap(master, *writer, clock);
+  ASSERT_TRUE(tap.send(etherCatFrame(1)).ok());
+  EXPECT_EQ(fileBytes(file.str()).size(), 24u) << "buffered while busy";
+  std::array<std::uint8_t, kMaxFrameSize> buf{};
+  ASSERT_EQ(*tap.receive(buf, 0ns), 0u);
+  EXPECT_EQ(fileBytes(file.str()).size(), 24u + 16 + 60) << "flushed when idle";
+  EXPECT_TRUE(tap.captureStatus().ok());
 }
 
 TEST(PcapReader, ReportsAMissingFile) {
