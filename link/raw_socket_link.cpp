@@ -1,6 +1,7 @@
 #include "link/raw_socket_link.hpp"
 
 #include <arpa/inet.h>
+#include <linux/filter.h>
 #include <linux/if_ether.h>   // ETH_P_ALL
 #include <linux/if_packet.h>  // tpacket_auxdata, besides what netpacket/packet.h has
 #include <net/if.h>
@@ -87,6 +88,19 @@ Result<RawSocketLink> RawSocketLink::open(std::string_view interface,
     return makeError(ErrorCode::kIo, "PACKET_AUXDATA on " + place + ": " + errnoText(errno));
   }
 
+  // Only EtherCAT frames reach the socket's queue (a busy NIC's other traffic would crowd
+  // it). Any VLAN tag is already off the data here, so the EtherType is at byte 12.
+  std::array<sock_filter, 4> filter{{
+      BPF_STMT(BPF_LD | BPF_H | BPF_ABS, 12),
+      BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, kEtherTypeEtherCat, 0, 1),
+      BPF_STMT(BPF_RET | BPF_K, 0xFFFF),  // the whole frame
+      BPF_STMT(BPF_RET | BPF_K, 0),       // nothing
+  }};
+  const sock_fprog program{static_cast<unsigned short>(filter.size()), filter.data()};
+  if (::setsockopt(fd, SOL_SOCKET, SO_ATTACH_FILTER, &program, sizeof program) != 0) {
+    return makeError(ErrorCode::kIo, "EtherCAT filter on " + place + ": " + errnoText(errno));
+  }
+
   sockaddr_ll addr{};
   addr.sll_family = AF_PACKET;
   // All EtherTypes, filtered in receive(): a socket bound to 0x88A4 gets a VLAN-tagged frame
@@ -152,7 +166,8 @@ Result<std::size_t> RawSocketLink::receive(Bytes buffer, std::chrono::nanosecond
         ++outgoingSkipped_;
         continue;
       }
-      if (from.sll_protocol != htons(kEtherTypeEtherCat)) continue;  // after any VLAN tag
+      // The filter passes only EtherCAT; this also holds if it were not there.
+      if (from.sll_protocol != htons(kEtherTypeEtherCat)) continue;
       auto length = static_cast<std::size_t>(n);
       if (length > buffer.size()) {
         return makeError(ErrorCode::kTooLarge, describe() + ": frame of " + std::to_string(length) +

@@ -1,6 +1,6 @@
 // RawSocketLink: an AF_PACKET raw socket on one network interface (a veth end, a TAP device
-// or a real NIC); receive() hands out only EtherCAT frames (EtherType 0x88A4, after an
-// optional VLAN tag) and skips all others. Frames the
+// or a real NIC); a socket filter lets only EtherCAT frames (EtherType 0x88A4, after an
+// optional VLAN tag) arrive. Frames the
 // socket sends itself are never received back (PACKET_IGNORE_OUTGOING where the kernel has
 // it, and a check of sll_pkttype == PACKET_OUTGOING in any case). The interface is put in
 // promiscuous mode through a packet-socket membership, which the kernel drops when the socket
