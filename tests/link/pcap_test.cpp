@@ -167,6 +167,22 @@ TEST(PcapWriter, FullDiskFailsAtOpenNamingTheFile) {
       << writer.error().context;
 }
 
+// A PcapTap on the master's end of a memory link pair, writing to a temporary file, stamped
+// with a virtual clock at 1000 ns.
+struct TapOnMemoryLink {
+  explicit TapOnMemoryLink(const std::string& name)
+      : file(name),
+        writer(std::move(PcapWriter::open(file.str())).value()),
+        links(MemoryLink::makePair(4)),
+        clock(1'000),
+        tap(links.first, writer, clock) {}
+  TempPath file;
+  PcapWriter writer;
+  std::pair<MemoryLink, MemoryLink> links;
+  VirtualClock clock;
+  PcapTap tap;
+};
+
 // A write error after open (here the file-size limit, as a full disk would) is reported by
 // the flush that meets it, names the file and the frames lost, and sticks: every later call
 // reports it, nothing is written past it.
@@ -195,12 +211,8 @@ TEST(PcapWriter, AWriteErrorSticksAndNamesTheFile) {
 
 // PcapTap flushes when a receive finds nothing waiting (the link is idle).
 TEST(PcapTap, AnIdleReceiveFlushes) {
-  TempPath file("tap_idle.pcap");
-  auto writer = PcapWriter::open(file.str());
-  ASSERT_TRUE(writer.ok());
-  auto [master, network] = MemoryLink::makePair(4);
-  VirtualClock clock(1'000);
-  PcapTap tap(master, *writer, clock);
+  TapOnMemoryLink t("tap_idle.pcap");
+  auto& [file, writer, links, clock, tap] = t;
   ASSERT_TRUE(tap.send(etherCatFrame(1)).ok());
   EXPECT_EQ(fileBytes(file.str()).size(), 24u) << "buffered while busy";
   std::array<std::uint8_t, kMaxFrameSize> buf{};
@@ -256,12 +268,9 @@ TEST(PcapReader, ReadsRealPcapngCaptures) {
 }
 
 TEST(PcapTap, RecordsBothDirectionsWithClockTime) {
-  TempPath file("tap.pcap");
-  auto writer = PcapWriter::open(file.str());
-  ASSERT_TRUE(writer.ok());
-  auto [master, network] = MemoryLink::makePair(4);
-  VirtualClock clock(1'000);
-  PcapTap tap(master, *writer, clock);
+  TapOnMemoryLink t("tap.pcap");
+  auto& [file, writer, links, clock, tap] = t;
+  auto& [master, network] = links;
   EXPECT_EQ(tap.pollFd(), master.pollFd());
   EXPECT_NE(tap.describe().find(file.str()), std::string::npos);
 
@@ -277,7 +286,7 @@ TEST(PcapTap, RecordsBothDirectionsWithClockTime) {
   ASSERT_EQ(*tap.receive(buf, 0ns), 0u);
   EXPECT_EQ(tap.framesCaptured(), 2u);
   EXPECT_TRUE(tap.captureStatus().ok());
-  ASSERT_TRUE(writer->close().ok());
+  ASSERT_TRUE(writer.close().ok());
 
   auto records = PcapReader::readAll(file.str());
   ASSERT_TRUE(records.ok()) << records.error().message();
