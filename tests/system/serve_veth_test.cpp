@@ -366,7 +366,9 @@ TEST(ServeVethCapture, SigkillDuringTrafficLeavesACaptureCapinfosReads) {
   const std::string pcap = uniqueTempPath("serve_kill.pcap");
   const std::string log = uniqueTempPath("serve_kill.log");
   std::filesystem::remove(pcap);
-  ServedNetwork net(*ns, 2, pcap, log);
+  // SIGKILL leaves the control socket behind: in the temporary folder, removed below.
+  const std::string control = uniqueTempPath("serve_kill.sock");
+  ServedNetwork net(*ns, 2, pcap, log, {"--control", control});
   ASSERT_TRUE(net.ok());
   ASSERT_TRUE(net.waitReady()) << readText(log);
   for (int i = 0; i < 10; ++i) ASSERT_TRUE(net.datagram(Command::kBrd, 0, {0, 0}));
@@ -410,6 +412,7 @@ TEST(ServeVethCapture, SigkillDuringTrafficLeavesACaptureCapinfosReads) {
     std::printf("capture after SIGKILL: %zu records, the last one %.1f ms before the kill\n",
                 records->size(), static_cast<double>(killedAt - records->back().timestampNs) / 1e6);
   }
+  std::filesystem::remove(control);
   if (!HasFailure()) {
     std::filesystem::remove(pcap);
     std::filesystem::remove(log);
