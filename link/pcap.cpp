@@ -1,34 +1,72 @@
 #include "link/pcap.hpp"
 
+#include <fcntl.h>
 #include <pcap/pcap.h>
+#include <unistd.h>
 
-#include <cstdio>
+#include <algorithm>
+#include <array>
+#include <cerrno>
 #include <mutex>
+#include <optional>
+
+#include "link/fd.hpp"
 
 namespace ecsim {
+namespace {
+
+// Classic pcap, nanosecond variant (libpcap's file format): a 24-byte file header, then per
+// frame a 16-byte record header (seconds, nanoseconds, captured length, original length).
+constexpr std::uint32_t kPcapMagicNanoseconds = 0xa1b23c4d;
+constexpr std::size_t kPcapFileHeaderSize = 24;
+constexpr std::size_t kPcapRecordHeaderSize = 16;
+// Whole records wait here and go to the file in one write(2): a crash never leaves a record
+// cut at a buffer boundary. Sized for many frames, and always for one record of the largest.
+constexpr std::size_t kWriteBufferSize = 128 * 1024;
+static_assert(kWriteBufferSize >= kPcapRecordHeaderSize + kPcapSnapLength);
+
+// Writes all of `data`; errno text on failure.
+Status writeAll(int fd, ConstBytes data, const std::string& what) {
+  std::size_t done = 0;
+  while (done < data.size()) {
+    const ssize_t n = ::write(fd, data.data() + done, data.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return makeError(ErrorCode::kIo, what + ": " + errnoText(n < 0 ? errno : EIO));
+    done += static_cast<std::size_t>(n);
+  }
+  return okStatus();
+}
+
+}  // namespace
 
 struct PcapWriter::Impl {
   std::mutex mutex;
-  pcap_t* handle{nullptr};
-  pcap_dumper_t* dumper{nullptr};
+  UniqueFd fd;
   std::string path;
   std::uint64_t frames{0};
+  std::vector<std::uint8_t> buffer;  // whole records not yet written; capacity kWriteBufferSize
+  std::uint64_t bufferedFrames{0};
+  std::optional<SimTime> lastFlush;  // by the caller's clock (flushIfDue)
+  Status failed;                     // the first write error: every later call reports it
 
   ~Impl() { (void)closeLocked(); }
 
+  Status flushLocked() {
+    if (!failed.ok()) return failed;
+    if (buffer.empty() || !fd.valid()) return okStatus();
+    Status written = writeAll(
+        fd.get(), buffer,
+        "writing capture file " + path + " (" + std::to_string(bufferedFrames) + " frame(s) lost)");
+    buffer.clear();
+    bufferedFrames = 0;
+    if (!written.ok()) failed = written;
+    return written;
+  }
+
   Status closeLocked() {
-    Status status;
-    if (dumper != nullptr) {
-      if (pcap_dump_flush(dumper) != 0) {
-        status = makeError(ErrorCode::kIo, "flushing capture file " + path);
-      }
-      pcap_dump_close(dumper);
-      dumper = nullptr;
-    }
-    if (handle != nullptr) {
-      pcap_close(handle);
-      handle = nullptr;
-    }
+    if (!fd.valid()) return okStatus();
+    Status status = flushLocked();
+    fd.reset();
     return status;
   }
 };
@@ -39,56 +77,79 @@ PcapWriter& PcapWriter::operator=(PcapWriter&&) noexcept = default;
 PcapWriter::~PcapWriter() = default;
 
 Result<PcapWriter> PcapWriter::open(const std::string& path, int linkType) {
+  if (linkType < 0) {
+    return makeError(ErrorCode::kUnsupported,
+                     "link type " + std::to_string(linkType) + " for capture file " + path);
+  }
   auto impl = std::make_unique<Impl>();
   impl->path = path;
-  impl->handle =
-      pcap_open_dead_with_tstamp_precision(linkType, kPcapSnapLength, PCAP_TSTAMP_PRECISION_NANO);
-  if (impl->handle == nullptr) {
-    return makeError(ErrorCode::kUnsupported,
-                     "libpcap refused link type " + std::to_string(linkType) + " for " + path);
+  // O_NONBLOCK only for the open: a FIFO nobody reads fails at once instead of blocking.
+  impl->fd.reset(::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC | O_NONBLOCK, 0644));
+  if (!impl->fd.valid()) {
+    return makeError(ErrorCode::kIo, "creating capture file " + path + ": " + errnoText(errno));
   }
-  impl->dumper = pcap_dump_open(impl->handle, path.c_str());
-  if (impl->dumper == nullptr) {
-    return makeError(ErrorCode::kIo,
-                     "creating capture file " + path + ": " + pcap_geterr(impl->handle));
+  const int flags = ::fcntl(impl->fd.get(), F_GETFL);
+  if (flags < 0 || ::fcntl(impl->fd.get(), F_SETFL, flags & ~O_NONBLOCK) != 0) {
+    return makeError(ErrorCode::kIo, "capture file " + path + ": fcntl: " + errnoText(errno));
   }
+  // The header goes to the file now: a capture killed before its first flush is still valid.
+  std::array<std::uint8_t, kPcapFileHeaderSize> header{};
+  writeLe32(header, 0, kPcapMagicNanoseconds);
+  writeLe16(header, 4, 2);  // version 2.4
+  writeLe16(header, 6, 4);
+  writeLe32(header, 16, static_cast<std::uint32_t>(kPcapSnapLength));
+  writeLe32(header, 20, static_cast<std::uint32_t>(linkType));
+  ECSIM_TRY(writeAll(impl->fd.get(), header, "writing the header of capture file " + path));
+  impl->buffer.reserve(kWriteBufferSize);
   return PcapWriter(std::move(impl));
 }
 
 Status PcapWriter::write(ConstBytes frame, SimTime timestampNs) {
   std::lock_guard lock(impl_->mutex);
-  if (impl_->dumper == nullptr) {
+  if (!impl_->fd.valid()) {
     return makeError(ErrorCode::kState, "capture file " + impl_->path + " is closed");
   }
+  if (!impl_->failed.ok()) return impl_->failed;
   constexpr SimTime kMaxSeconds = SimTime{1} << 32;
   if (timestampNs < 0 || timestampNs / kNsPerSecond >= kMaxSeconds) {
     return makeError(ErrorCode::kInvalidArgument, "capture file " + impl_->path + ": timestamp " +
                                                       std::to_string(timestampNs) +
                                                       " ns is outside the pcap range");
   }
-  pcap_pkthdr header{};
-  header.ts.tv_sec = static_cast<time_t>(timestampNs / kNsPerSecond);
-  // With nanosecond precision libpcap stores the sub-second field as nanoseconds.
-  header.ts.tv_usec = static_cast<suseconds_t>(timestampNs % kNsPerSecond);
-  header.len = static_cast<bpf_u_int32>(frame.size());
-  header.caplen = static_cast<bpf_u_int32>(
-      frame.size() < static_cast<std::size_t>(kPcapSnapLength) ? frame.size() : kPcapSnapLength);
-  pcap_dump(reinterpret_cast<u_char*>(impl_->dumper), &header, frame.data());
-  if (std::ferror(pcap_dump_file(impl_->dumper)) != 0) {
-    return makeError(ErrorCode::kIo, "writing frame " + std::to_string(impl_->frames + 1) +
-                                         " to capture file " + impl_->path);
+  const std::size_t captured =
+      frame.size() < static_cast<std::size_t>(kPcapSnapLength) ? frame.size() : kPcapSnapLength;
+  auto& buffer = impl_->buffer;
+  if (buffer.size() + kPcapRecordHeaderSize + captured > kWriteBufferSize) {
+    ECSIM_TRY(impl_->flushLocked());
   }
+  // Within the reserved capacity: no allocation.
+  const std::size_t at = buffer.size();
+  buffer.resize(at + kPcapRecordHeaderSize + captured);
+  writeLe32(buffer, at, static_cast<std::uint32_t>(timestampNs / kNsPerSecond));
+  writeLe32(buffer, at + 4, static_cast<std::uint32_t>(timestampNs % kNsPerSecond));
+  writeLe32(buffer, at + 8, static_cast<std::uint32_t>(captured));
+  writeLe32(buffer, at + 12, static_cast<std::uint32_t>(frame.size()));
+  std::copy_n(frame.begin(), captured,
+              buffer.begin() + static_cast<long>(at + kPcapRecordHeaderSize));
+  ++impl_->bufferedFrames;
   ++impl_->frames;
   return okStatus();
 }
 
 Status PcapWriter::flush() {
   std::lock_guard lock(impl_->mutex);
-  if (impl_->dumper == nullptr) return okStatus();
-  if (pcap_dump_flush(impl_->dumper) != 0) {
-    return makeError(ErrorCode::kIo, "flushing capture file " + impl_->path);
+  return impl_->flushLocked();
+}
+
+Status PcapWriter::flushIfDue(SimTime now) {
+  std::lock_guard lock(impl_->mutex);
+  if (impl_->buffer.empty() || !impl_->lastFlush) {
+    impl_->lastFlush = now;  // records buffered from here on wait at most the interval
+    return impl_->failed;
   }
-  return okStatus();
+  if (now - *impl_->lastFlush < kCaptureFlushInterval) return okStatus();
+  impl_->lastFlush = now;
+  return impl_->flushLocked();
 }
 
 Status PcapWriter::close() {
@@ -98,7 +159,7 @@ Status PcapWriter::close() {
 
 bool PcapWriter::isOpen() const {
   std::lock_guard lock(impl_->mutex);
-  return impl_->dumper != nullptr;
+  return impl_->fd.valid();
 }
 
 const std::string& PcapWriter::path() const {

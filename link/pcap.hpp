@@ -1,7 +1,10 @@
-// Capture files through libpcap. PcapWriter writes classic pcap with nanosecond timestamps
-// (magic 0xa1b23c4d) and takes the timestamp from the caller, so the simulator can stamp
-// frames with model time. PcapReader reads pcap and pcapng and hands out nanosecond
-// timestamps. libpcap's types stay inside pcap.cpp.
+// Capture files. PcapWriter writes classic pcap with nanosecond timestamps (magic 0xa1b23c4d)
+// itself and takes the timestamp from the caller, so the simulator can stamp frames with model
+// time. It is built to be trusted after a crash: the file header is written at open, records
+// are buffered whole and written in one write(2) (never a record cut in two), flushIfDue()
+// and flush() put them on disk, and the first write error sticks. PcapReader reads pcap and
+// pcapng through libpcap and hands out nanosecond timestamps; libpcap's types stay inside
+// pcap.cpp.
 #pragma once
 
 #include <cstdint>
@@ -18,12 +21,17 @@ namespace ecsim {
 
 constexpr int kLinkTypeEthernet = 1;  // LINKTYPE_ETHERNET / DLT_EN10MB
 constexpr int kPcapSnapLength = 65535;
+// Buffered records reach the file at least this often (by the caller's clock, flushIfDue).
+constexpr SimTime kCaptureFlushInterval = 100 * kNsPerMs;
 
 // Writes one capture file. Safe to share between threads (a sender and a receiver thread
 // recording through PcapTaps): each call holds an internal lock. Frames longer than the
-// snap length are cut, keeping their original length in the record.
+// snap length are cut, keeping their original length in the record. write() only buffers:
+// call flushIfDue(now) regularly and flush() when idle, or records wait until close().
 class PcapWriter {
  public:
+  // kIo naming the path when the file cannot be made or its header not written (a full disk
+  // fails here). A FIFO nobody reads fails at once instead of blocking.
   static Result<PcapWriter> open(const std::string& path, int linkType = kLinkTypeEthernet);
 
   PcapWriter(PcapWriter&&) noexcept;
@@ -34,6 +42,9 @@ class PcapWriter {
   // 2^32 seconds (the classic pcap range).
   Status write(ConstBytes frame, SimTime timestampNs);
   Status flush();
+  // Flushes when records have waited kCaptureFlushInterval since the last flush, by the
+  // caller's clock (`now`); the writer never reads a clock itself.
+  Status flushIfDue(SimTime now);
   // Flushes and closes; later writes fail with kState. Closing twice is fine.
   Status close();
 

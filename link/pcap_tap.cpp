@@ -13,7 +13,11 @@ Status PcapTap::send(ConstBytes frame) {
 
 Result<std::size_t> PcapTap::receive(Bytes buffer, std::chrono::nanoseconds timeout) {
   Result<std::size_t> length = inner_.receive(buffer, timeout);
-  if (length.ok() && *length > 0) record(ConstBytes(buffer.data(), *length));
+  if (length.ok() && *length > 0) {
+    record(ConstBytes(buffer.data(), *length));
+  } else if (length.ok()) {
+    keep(writer_.flush());  // idle: what was captured goes to the file now
+  }
   return length;
 }
 
@@ -27,11 +31,17 @@ Status PcapTap::captureStatus() const {
 }
 
 void PcapTap::record(ConstBytes frame) {
-  Status status = writer_.write(frame, clock_.now());
+  const SimTime now = clock_.now();
+  Status status = writer_.write(frame, now);
   if (status.ok()) {
     captured_.fetch_add(1, std::memory_order_relaxed);
-    return;
+    status = writer_.flushIfDue(now);
   }
+  keep(std::move(status));
+}
+
+void PcapTap::keep(Status status) {
+  if (status.ok()) return;
   std::lock_guard lock(errorMutex_);
   if (firstError_.ok()) firstError_ = std::move(status);
 }

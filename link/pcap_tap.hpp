@@ -1,6 +1,7 @@
 // PcapTap: a Link decorator that records every frame sent and received through it into a
 // PcapWriter, stamped with the time of the Clock it is given (WallClock for live captures,
-// the simulator's model clock for virtual time).
+// the simulator's model clock for virtual time). Records reach the file when a receive finds
+// nothing waiting and at least every kCaptureFlushInterval of that clock.
 #pragma once
 
 #include <atomic>
@@ -34,6 +35,7 @@ class PcapTap final : public Link {
 
  private:
   void record(ConstBytes frame);
+  void keep(Status status);  // remembers the first capture error
 
   Link& inner_;
   PcapWriter& writer_;

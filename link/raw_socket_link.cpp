@@ -1,11 +1,14 @@
 #include "link/raw_socket_link.hpp"
 
 #include <arpa/inet.h>
+#include <linux/filter.h>
+#include <linux/if_ether.h>   // ETH_P_ALL
+#include <linux/if_packet.h>  // tpacket_auxdata, besides what netpacket/packet.h has
 #include <net/if.h>
-#include <netpacket/packet.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
 
+#include <array>
 #include <cerrno>
 #include <cstring>
 
@@ -79,10 +82,31 @@ Result<RawSocketLink> RawSocketLink::open(std::string_view interface,
   if (::setsockopt(fd, SOL_PACKET, PACKET_IGNORE_OUTGOING, &one, sizeof one) == 0) {
     link.kernelIgnoresOutgoing_ = true;
   }  // else: older kernel, receive() filters on sll_pkttype
+  // The kernel takes an 802.1Q tag off a received frame and reports it aside; receive() puts
+  // it back, so a tagged request is answered tagged, as a real ESC passes the tag through.
+  if (::setsockopt(fd, SOL_PACKET, PACKET_AUXDATA, &one, sizeof one) != 0) {
+    return makeError(ErrorCode::kIo, "PACKET_AUXDATA on " + place + ": " + errnoText(errno));
+  }
+
+  // Only EtherCAT frames reach the socket's queue (a busy NIC's other traffic would crowd
+  // it). Any VLAN tag is already off the data here, so the EtherType is at byte 12.
+  std::array<sock_filter, 4> filter{{
+      BPF_STMT(BPF_LD | BPF_H | BPF_ABS, 12),
+      BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, kEtherTypeEtherCat, 0, 1),
+      BPF_STMT(BPF_RET | BPF_K, 0xFFFF),  // the whole frame
+      BPF_STMT(BPF_RET | BPF_K, 0),       // nothing
+  }};
+  const sock_fprog program{static_cast<unsigned short>(filter.size()), filter.data()};
+  if (::setsockopt(fd, SOL_SOCKET, SO_ATTACH_FILTER, &program, sizeof program) != 0) {
+    return makeError(ErrorCode::kIo, "EtherCAT filter on " + place + ": " + errnoText(errno));
+  }
 
   sockaddr_ll addr{};
   addr.sll_family = AF_PACKET;
-  addr.sll_protocol = htons(kEtherTypeEtherCat);
+  // All EtherTypes, filtered in receive(): a socket bound to 0x88A4 gets a VLAN-tagged frame
+  // only after the kernel has dropped its tag for good (no VLAN device of that ID), while one
+  // bound to all sees the tag in PACKET_AUXDATA.
+  addr.sll_protocol = htons(ETH_P_ALL);
   addr.sll_ifindex = link.ifindex_;
   if (::bind(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) != 0) {
     return makeError(ErrorCode::kIo, "binding raw socket to " + place + ": " + errnoText(errno));
@@ -126,23 +150,32 @@ Result<std::size_t> RawSocketLink::receive(Bytes buffer, std::chrono::nanosecond
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   for (;;) {
     sockaddr_ll from{};
-    socklen_t fromLength = sizeof from;
+    iovec data{buffer.data(), buffer.size()};
+    alignas(cmsghdr) std::array<std::uint8_t, CMSG_SPACE(sizeof(tpacket_auxdata))> control{};
+    msghdr message{};
+    message.msg_name = &from;
+    message.msg_namelen = sizeof from;
+    message.msg_iov = &data;
+    message.msg_iovlen = 1;
+    message.msg_control = control.data();
+    message.msg_controllen = control.size();
     // MSG_TRUNC: the return value is the real frame length even when the buffer is smaller.
-    const ssize_t n = ::recvfrom(fd_.get(), buffer.data(), buffer.size(), MSG_DONTWAIT | MSG_TRUNC,
-                                 reinterpret_cast<sockaddr*>(&from), &fromLength);
+    const ssize_t n = ::recvmsg(fd_.get(), &message, MSG_DONTWAIT | MSG_TRUNC);
     if (n > 0) {
       if (from.sll_pkttype == PACKET_OUTGOING) {
         ++outgoingSkipped_;
         continue;
       }
-      const auto length = static_cast<std::size_t>(n);
+      // The filter passes only EtherCAT; this also holds if it were not there.
+      if (from.sll_protocol != htons(kEtherTypeEtherCat)) continue;
+      auto length = static_cast<std::size_t>(n);
       if (length > buffer.size()) {
         return makeError(ErrorCode::kTooLarge, describe() + ": frame of " + std::to_string(length) +
                                                    " bytes exceeds receive buffer of " +
                                                    std::to_string(buffer.size()) +
                                                    " bytes, frame dropped");
       }
-      return length;
+      return restoreVlanTag(message, buffer, length);
     }
     if (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) {
       return makeError(ErrorCode::kIo, describe() + ": recvfrom: " + errnoText(errno));
@@ -155,6 +188,31 @@ Result<std::size_t> RawSocketLink::receive(Bytes buffer, std::chrono::nanosecond
         waitReadable(fd_.get(), std::chrono::duration_cast<std::chrono::nanoseconds>(left)));
     if (!readable) return std::size_t{0};
   }
+}
+
+Result<std::size_t> RawSocketLink::restoreVlanTag(const msghdr& message, Bytes buffer,
+                                                  std::size_t length) const {
+  for (const cmsghdr* c = CMSG_FIRSTHDR(&message); c != nullptr;
+       c = CMSG_NXTHDR(const_cast<msghdr*>(&message), const_cast<cmsghdr*>(c))) {
+    if (c->cmsg_level != SOL_PACKET || c->cmsg_type != PACKET_AUXDATA) continue;
+    tpacket_auxdata aux{};
+    std::memcpy(&aux, CMSG_DATA(c), sizeof aux);
+    if ((aux.tp_status & TP_STATUS_VLAN_VALID) == 0) return length;
+    if (length < kEthernetHeaderSize || length + kVlanTagSize > buffer.size()) {
+      return makeError(ErrorCode::kTooLarge, describe() + ": VLAN-tagged frame of " +
+                                                 std::to_string(length + kVlanTagSize) +
+                                                 " bytes exceeds " + std::to_string(buffer.size()) +
+                                                 " bytes, frame dropped");
+    }
+    // The tag sits between the source address and the EtherType, as it was on the wire.
+    constexpr std::size_t kTagAt = 2 * std::tuple_size_v<MacAddress>;
+    std::memmove(buffer.data() + kTagAt + kVlanTagSize, buffer.data() + kTagAt, length - kTagAt);
+    const bool tpidKnown = (aux.tp_status & TP_STATUS_VLAN_TPID_VALID) != 0;
+    writeBe16(buffer, kTagAt, tpidKnown ? aux.tp_vlan_tpid : kEtherTypeVlan);
+    writeBe16(buffer, kTagAt + 2, aux.tp_vlan_tci);
+    return length + kVlanTagSize;
+  }
+  return length;
 }
 
 std::string RawSocketLink::describe() const {

@@ -1,9 +1,11 @@
 // RawSocketLink: an AF_PACKET raw socket on one network interface (a veth end, a TAP device
-// or a real NIC), bound to EtherType 0x88A4 so that only EtherCAT frames arrive. Frames the
+// or a real NIC); a socket filter lets only EtherCAT frames (EtherType 0x88A4, after an
+// optional VLAN tag) arrive. Frames the
 // socket sends itself are never received back (PACKET_IGNORE_OUTGOING where the kernel has
 // it, and a check of sll_pkttype == PACKET_OUTGOING in any case). The interface is put in
 // promiscuous mode through a packet-socket membership, which the kernel drops when the socket
-// closes. Needs CAP_NET_RAW.
+// closes. An 802.1Q tag, which the kernel takes off received frames, is put back in place
+// (PACKET_AUXDATA), so frames arrive as they were on the wire. Needs CAP_NET_RAW.
 #pragma once
 
 #include <chrono>
@@ -14,6 +16,8 @@
 #include "link/fd.hpp"
 #include "link/link.hpp"
 #include "protocol/ethernet.hpp"
+
+struct msghdr;
 
 namespace ecsim {
 
@@ -53,6 +57,8 @@ class RawSocketLink final : public Link {
 
  private:
   RawSocketLink() = default;
+  // Puts back the 802.1Q tag the kernel took off (reported in PACKET_AUXDATA).
+  Result<std::size_t> restoreVlanTag(const msghdr& message, Bytes buffer, std::size_t length) const;
 
   UniqueFd fd_;
   std::string interface_;

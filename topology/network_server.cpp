@@ -47,9 +47,15 @@ Status NetworkServer::step(const std::function<bool()>& stop) {
   }
   ++counters_.framesReceived;
   Bytes frame(buffer_.data(), *received);
+  const std::uint64_t malformedBefore = segment_.counters().framesMalformed;
   FrameOutcome outcome = segment_.processFrame(frame, now);
   if (!outcome.delivered) {
     ++counters_.framesDropped;
+    // A malformed frame is left as it came (the segment refuses it before changing a byte).
+    if (options_.malformedObserver != nullptr &&
+        segment_.counters().framesMalformed != malformedBefore) {
+      options_.malformedObserver->onFrame(frame, now, true);
+    }
     return okStatus();
   }
   counters_.lastRoundTrip = outcome.returnTime - now;

@@ -27,6 +27,9 @@ struct ServerOptions {
   std::chrono::nanoseconds idleWait{std::chrono::milliseconds(1)};
   // Paced mode: the longest an answer is held.
   std::chrono::nanoseconds maxPacedWait{std::chrono::seconds(1)};
+  // Sees every malformed frame the server drops, as received, stamped with the clock's time
+  // (`ecsim serve --pcap-malformed`). Not owned; null: none.
+  CableObserver* malformedObserver{nullptr};
 };
 
 struct ServerCounters {

@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <unistd.h>
+
+#include <csignal>
 
 #include <array>
 #include <filesystem>
@@ -127,6 +130,97 @@ TEST(PcapWriter, ReportsAnUnwritablePath) {
   EXPECT_NE(writer.error().context.find("/nonexistent-dir-ecsim/x.pcap"), std::string::npos);
 }
 
+// Captures you can trust after a crash: the header is on disk at open, buffered records reach
+// the file within kCaptureFlushInterval of the caller's clock, and only whole records do.
+TEST(PcapWriter, HeaderIsOnDiskAtOpen) {
+  TempPath file("header.pcap");
+  auto writer = PcapWriter::open(file.str());
+  ASSERT_TRUE(writer.ok()) << writer.error().message();
+  EXPECT_EQ(fileBytes(file.str()).size(), 24u) << "a capture killed before its first frame";
+}
+
+TEST(PcapWriter, FlushIfDueWritesWholeRecordsOnceTheIntervalHasPassed) {
+  TempPath file("due.pcap");
+  auto writer = PcapWriter::open(file.str());
+  ASSERT_TRUE(writer.ok()) << writer.error().message();
+  const SimTime t0 = 5 * kNsPerSecond;
+  ASSERT_TRUE(writer->flushIfDue(t0).ok());
+  ASSERT_TRUE(writer->write(etherCatFrame(1), 1).ok());
+  ASSERT_TRUE(writer->write(etherCatFrame(2), 2).ok());
+  ASSERT_TRUE(writer->flushIfDue(t0 + kCaptureFlushInterval - 1).ok());
+  EXPECT_EQ(fileBytes(file.str()).size(), 24u) << "not due yet: buffered";
+  ASSERT_TRUE(writer->flushIfDue(t0 + kCaptureFlushInterval).ok());
+  EXPECT_EQ(fileBytes(file.str()).size(), 24u + 2 * (16 + 60)) << "due: both records written";
+  // Whatever is on disk reads back whole, before close.
+  auto records = PcapReader::readAll(file.str());
+  ASSERT_TRUE(records.ok()) << records.error().message();
+  EXPECT_EQ(records->size(), 2u);
+}
+
+TEST(PcapWriter, FullDiskFailsAtOpenNamingTheFile) {
+  ECSIM_REQUIRE_OR_SKIP(std::filesystem::exists("/dev/full"), "no /dev/full");
+  auto writer = PcapWriter::open("/dev/full");
+  ASSERT_FALSE(writer.ok()) << "the header write must fail on a full device";
+  EXPECT_EQ(writer.error().code, ErrorCode::kIo);
+  EXPECT_NE(writer.error().context.find("/dev/full"), std::string::npos) << writer.error().context;
+  EXPECT_NE(writer.error().context.find("No space left"), std::string::npos)
+      << writer.error().context;
+}
+
+// A PcapTap on the master's end of a memory link pair, writing to a temporary file, stamped
+// with a virtual clock at 1000 ns.
+struct TapOnMemoryLink {
+  explicit TapOnMemoryLink(const std::string& name)
+      : file(name),
+        writer(std::move(PcapWriter::open(file.str())).value()),
+        links(MemoryLink::makePair(4)),
+        clock(1'000),
+        tap(links.first, writer, clock) {}
+  TempPath file;
+  PcapWriter writer;
+  std::pair<MemoryLink, MemoryLink> links;
+  VirtualClock clock;
+  PcapTap tap;
+};
+
+// A write error after open (here the file-size limit, as a full disk would) is reported by
+// the flush that meets it, names the file and the frames lost, and sticks: every later call
+// reports it, nothing is written past it.
+TEST(PcapWriter, AWriteErrorSticksAndNamesTheFile) {
+  TempPath file("efbig.pcap");
+  const int code = testing::runInChild([&]() -> int {
+    std::signal(SIGXFSZ, SIG_IGN);  // in the child only: the write fails with EFBIG instead
+    const rlimit limit{200, 200};
+    if (::setrlimit(RLIMIT_FSIZE, &limit) != 0) return 100;
+    auto writer = PcapWriter::open(file.str());
+    if (!writer.ok()) return 1;
+    for (std::uint8_t i = 0; i < 5; ++i) {
+      if (!writer->write(etherCatFrame(i), i).ok()) return 2;
+    }
+    auto flushed = writer->flush();
+    if (flushed.ok() || flushed.error().code != ErrorCode::kIo) return 3;
+    if (flushed.error().context.find(file.str()) == std::string::npos) return 4;
+    if (flushed.error().context.find("5 frame(s) lost") == std::string::npos) return 5;
+    if (writer->write(etherCatFrame(9), 9).ok()) return 6;
+    if (writer->flushIfDue(kNsPerSecond).ok() || writer->close().ok()) return 7;
+    return 0;
+  });
+  EXPECT_EQ(code, 0) << "1: open, 2: buffered write, 3: flush not kIo, 4: no path, 5: no count, "
+                        "6: write after error, 7: error not sticky";
+}
+
+// PcapTap flushes when a receive finds nothing waiting (the link is idle).
+TEST(PcapTap, AnIdleReceiveFlushes) {
+  TapOnMemoryLink t("tap_idle.pcap");
+  auto& [file, writer, links, clock, tap] = t;
+  ASSERT_TRUE(tap.send(etherCatFrame(1)).ok());
+  EXPECT_EQ(fileBytes(file.str()).size(), 24u) << "buffered while busy";
+  std::array<std::uint8_t, kMaxFrameSize> buf{};
+  ASSERT_EQ(*tap.receive(buf, 0ns), 0u);
+  EXPECT_EQ(fileBytes(file.str()).size(), 24u + 16 + 60) << "flushed when idle";
+  EXPECT_TRUE(tap.captureStatus().ok());
+}
+
 TEST(PcapReader, ReportsAMissingFile) {
   auto reader = PcapReader::open("/nonexistent-dir-ecsim/y.pcap");
   ASSERT_FALSE(reader.ok());
@@ -174,12 +268,9 @@ TEST(PcapReader, ReadsRealPcapngCaptures) {
 }
 
 TEST(PcapTap, RecordsBothDirectionsWithClockTime) {
-  TempPath file("tap.pcap");
-  auto writer = PcapWriter::open(file.str());
-  ASSERT_TRUE(writer.ok());
-  auto [master, network] = MemoryLink::makePair(4);
-  VirtualClock clock(1'000);
-  PcapTap tap(master, *writer, clock);
+  TapOnMemoryLink t("tap.pcap");
+  auto& [file, writer, links, clock, tap] = t;
+  auto& [master, network] = links;
   EXPECT_EQ(tap.pollFd(), master.pollFd());
   EXPECT_NE(tap.describe().find(file.str()), std::string::npos);
 
@@ -195,7 +286,7 @@ TEST(PcapTap, RecordsBothDirectionsWithClockTime) {
   ASSERT_EQ(*tap.receive(buf, 0ns), 0u);
   EXPECT_EQ(tap.framesCaptured(), 2u);
   EXPECT_TRUE(tap.captureStatus().ok());
-  ASSERT_TRUE(writer->close().ok());
+  ASSERT_TRUE(writer.close().ok());
 
   auto records = PcapReader::readAll(file.str());
   ASSERT_TRUE(records.ok()) << records.error().message();

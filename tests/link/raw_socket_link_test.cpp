@@ -67,6 +67,32 @@ TEST_F(RawSocketLinkTest, CarriesEtherCatFramesBetweenTheEnds) {
   EXPECT_EQ(std::vector<std::uint8_t>(buf_.begin(), buf_.begin() + 60), reply);
 }
 
+// An 802.1Q-tagged EtherCAT frame arrives with its tag where it was on the wire: the kernel
+// strips the tag before the socket and reports it aside (PACKET_AUXDATA); receive() puts it
+// back, so an answer built in place carries it as a real ESC passes it through.
+TEST_F(RawSocketLinkTest, ReceivesAVlanTaggedFrameWithItsTag) {
+  auto master = open(ns_->masterInterface());
+  ASSERT_TRUE(master.ok()) << master.error().message();
+  auto sim = open(ns_->simulatorInterface());
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  const auto plain = etherCatFrame(7);
+  std::vector<std::uint8_t> tagged(plain.begin(), plain.begin() + 12);
+  const std::uint16_t tci = 0x6005;  // priority 3, VLAN 5
+  tagged.insert(tagged.end(), {0x81, 0x00, static_cast<std::uint8_t>(tci >> 8),
+                               static_cast<std::uint8_t>(tci & 0xFF)});
+  tagged.insert(tagged.end(), plain.begin() + 12, plain.end());
+  ASSERT_TRUE(master->send(tagged).ok());
+  auto n = sim->receive(buf_, 2s);
+  ASSERT_TRUE(n.ok()) << n.error().message();
+  ASSERT_EQ(*n, tagged.size()) << "the 4-byte tag is missing";
+  EXPECT_EQ(std::vector<std::uint8_t>(buf_.begin(), buf_.begin() + static_cast<long>(*n)), tagged);
+  // An untagged frame stays untagged.
+  ASSERT_TRUE(master->send(plain).ok());
+  n = sim->receive(buf_, 2s);
+  ASSERT_TRUE(n.ok()) << n.error().message();
+  EXPECT_EQ(std::vector<std::uint8_t>(buf_.begin(), buf_.begin() + static_cast<long>(*n)), plain);
+}
+
 TEST_F(RawSocketLinkTest, DoesNotDeliverOtherEtherTypes) {
   auto master = open(ns_->masterInterface());
   auto sim = open(ns_->simulatorInterface());

@@ -22,6 +22,13 @@ bool linkExists(const VethNamespace& ns, const std::string& ifname) {
   return out.ok() && out->exitCode == 0;
 }
 
+// Runs a set-up command inside the namespace: "" when it succeeded, else what went wrong.
+std::string setUp(const VethNamespace& ns, const std::vector<std::string>& argv) {
+  auto out = ns.run(argv);
+  if (!out.ok()) return out.error().message();
+  return out->exitCode == 0 ? "" : out->output;
+}
+
 std::string uniqueName() {
   return "t" + std::to_string(::getpid() % 100000) + "x";
 }
@@ -51,6 +58,81 @@ TEST(NetSetup, UpCreatesTheConfiguredPairAndDownRemovesIt) {
   auto again = ns->run({kEcsim, "net", "down", name});
   ASSERT_TRUE(again.ok());
   EXPECT_NE(again->exitCode, 0) << "nothing left to remove is reported";
+}
+
+// Interfaces ecsim did not create are never touched: `net up` and `serve --veth` refuse a name
+// that exists (either end), and the failure removes nothing (it used to delete the pair).
+TEST(NetSetup, UpAndServeVethRefuseAnExistingInterfaceAndLeaveIt) {
+  ECSIM_REQUIRE_NETWORK();
+  auto ns = VethNamespace::create();
+  ASSERT_TRUE(ns.ok()) << ns.error().message();
+  const std::string name = uniqueName() + "e";
+  ASSERT_EQ(setUp(*ns, {"ip", "link", "add", name, "type", "veth", "peer", "name", name + "q"}),
+            "");
+  auto up = ns->run({kEcsim, "net", "up", name});
+  ASSERT_TRUE(up.ok());
+  EXPECT_NE(up->exitCode, 0) << up->output;
+  EXPECT_NE(up->output.find("'" + name + "' already exists"), std::string::npos) << up->output;
+  EXPECT_TRUE(linkExists(*ns, name)) << "a failed up deleted someone else's interface";
+  EXPECT_TRUE(linkExists(*ns, name + "q")) << "a failed up deleted the peer";
+  const std::string log = uniqueTempPath("serve_veth_" + name + ".log");
+  auto serve =
+      ns->spawn({kEcsim, "serve", "--veth", name, "--slaves", "1"}, SpawnOptions{log, log});
+  ASSERT_TRUE(serve.ok());
+  auto code = serve->wait(kReadyTimeout);
+  if (!code.ok()) (void)serve->stop();
+  ASSERT_TRUE(code.ok()) << "serve --veth of an existing name serves: " << readWholeFile(log);
+  EXPECT_NE(*code, 0) << readWholeFile(log);
+  EXPECT_NE(readWholeFile(log).find("already exists"), std::string::npos) << readWholeFile(log);
+  if (!HasFailure()) std::filesystem::remove(log);
+  EXPECT_TRUE(linkExists(*ns, name)) << "a failed serve --veth deleted someone else's interface";
+  EXPECT_TRUE(linkExists(*ns, name + "q"));
+  auto down = ns->run({kEcsim, "net", "down", name});
+  ASSERT_TRUE(down.ok());
+  EXPECT_NE(down->exitCode, 0) << "nothing of ecsim's to remove: " << down->output;
+  EXPECT_TRUE(linkExists(*ns, name)) << "down removed an interface up never made";
+  // The simulator's end NAMEs taken by someone else: refused the same way.
+  const std::string other = uniqueName() + "f";
+  ASSERT_EQ(
+      setUp(*ns, {"ip", "link", "add", other + "s", "type", "veth", "peer", "name", other + "q"}),
+      "");
+  up = ns->run({kEcsim, "net", "up", other});
+  ASSERT_TRUE(up.ok());
+  EXPECT_NE(up->exitCode, 0) << up->output;
+  EXPECT_NE(up->output.find("'" + other + "s' already exists"), std::string::npos) << up->output;
+  EXPECT_TRUE(linkExists(*ns, other + "s"));
+  EXPECT_TRUE(linkExists(*ns, other + "q"));
+  EXPECT_FALSE(linkExists(*ns, other)) << "nothing half-made left behind";
+}
+
+// The state file proves what `up` made: a pair of the same name made later by someone else
+// (after ours was removed by hand) is not ours, and `down` leaves it alone.
+TEST(NetSetup, DownLeavesAPairOfTheSameNameItDidNotCreate) {
+  ECSIM_REQUIRE_NETWORK();
+  auto ns = VethNamespace::create();
+  ASSERT_TRUE(ns.ok()) << ns.error().message();
+  const std::string name = uniqueName() + "r";
+  auto up = ns->run({kEcsim, "net", "up", name});
+  ASSERT_TRUE(up.ok());
+  ASSERT_EQ(up->exitCode, 0) << up->output;
+  ASSERT_EQ(setUp(*ns, {"ip", "link", "del", name}), "");
+  ASSERT_EQ(setUp(*ns, {"ip", "link", "add", name, "type", "veth", "peer", "name", name + "s"}),
+            "");
+  auto down = ns->run({kEcsim, "net", "down", name});
+  ASSERT_TRUE(down.ok());
+  EXPECT_NE(down->exitCode, 0) << down->output;
+  EXPECT_NE(down->output.find("left alone"), std::string::npos) << down->output;
+  EXPECT_TRUE(linkExists(*ns, name)) << "down deleted a pair it did not create";
+  EXPECT_TRUE(linkExists(*ns, name + "s"));
+  // The stale record is gone: a second down finds nothing, an up refuses the existing name.
+  auto again = ns->run({kEcsim, "net", "down", name});
+  ASSERT_TRUE(again.ok());
+  EXPECT_NE(again->exitCode, 0);
+  EXPECT_TRUE(linkExists(*ns, name));
+  up = ns->run({kEcsim, "net", "up", name});
+  ASSERT_TRUE(up.ok());
+  EXPECT_NE(up->exitCode, 0) << up->output;
+  EXPECT_TRUE(linkExists(*ns, name));
 }
 
 TEST(NetSetup, SigkilledServeLeavesAPairTheNextUpCleans) {

@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "link/netns.hpp"
+#include "link/pcap.hpp"
 #include "link/raw_socket_link.hpp"
 #include "protocol/frame.hpp"
 #include "support/privileges.hpp"
@@ -32,6 +33,15 @@ std::string readText(const std::string& path) {
   return s.str();
 }
 
+// A tool the test needs (tshark, capinfos): missing is a failure under CI=true, else a skip.
+#define REQUIRE_TOOL(probe, tool)                                  \
+  do {                                                             \
+    if (!runCommand(probe).ok()) {                                 \
+      if (ciMode()) FAIL() << tool << " missing under CI=true";    \
+      GTEST_SKIP() << tool << " not installed (wireshark-common)"; \
+    }                                                              \
+  } while (false)
+
 // Waits for the end of `ecsim serve` after SIGINT: a bound against a hang, generous because a
 // sanitizer build on a busy machine is slow to finish and report.
 constexpr std::chrono::seconds kExitWait{30};
@@ -39,7 +49,7 @@ constexpr std::chrono::seconds kExitWait{30};
 class ServedNetwork {
  public:
   ServedNetwork(const VethNamespace& ns, unsigned slaves, const std::string& pcap,
-                const std::string& log)
+                const std::string& log, const std::vector<std::string>& extra = {})
       : ns_(ns) {
     std::vector<std::string> argv{
         kEcsim, "serve", "--iface", ns.simulatorInterface(), "--slaves", std::to_string(slaves)};
@@ -47,6 +57,7 @@ class ServedNetwork {
       argv.push_back("--pcap");
       argv.push_back(pcap);
     }
+    argv.insert(argv.end(), extra.begin(), extra.end());
     auto child = ns.spawn(argv, SpawnOptions{log, log});
     if (child.ok()) child_ = std::move(child).value();
     auto link = RawSocketLink::open(ns.masterInterface(), RawSocketOptions{ns.name(), true});
@@ -214,10 +225,7 @@ TEST(ServeVethRobustness, SurvivesTenThousandMalformedFrames) {
 
 TEST(ServeVethCapture, TsharkDecodesEveryFrameAsEtherCat) {
   ECSIM_REQUIRE_NETWORK();
-  if (!runCommand({"tshark", "--version"}).ok()) {
-    if (ciMode()) FAIL() << "tshark missing under CI=true";
-    GTEST_SKIP() << "tshark not installed";
-  }
+  REQUIRE_TOOL((std::vector<std::string>{"tshark", "--version"}), "tshark");
   auto ns = VethNamespace::create();
   ASSERT_TRUE(ns.ok()) << ns.error().message();
   const std::string pcap = uniqueTempPath("serve_capture.pcap");
@@ -266,6 +274,169 @@ TEST(ServeVethCapture, TsharkDecodesEveryFrameAsEtherCat) {
     std::filesystem::remove(pcap);
     std::filesystem::remove(log);
   }
+}
+
+// A VLAN-tagged request is answered with the same tag (the kernel strips it before the
+// simulator's socket; it used to answer untagged).
+TEST(ServeVethVlan, AnswersATaggedFrameWithTheSameTci) {
+  ECSIM_REQUIRE_NETWORK();
+  auto ns = VethNamespace::create();
+  ASSERT_TRUE(ns.ok()) << ns.error().message();
+  const std::string log = uniqueTempPath("serve_vlan.log");
+  ServedNetwork net(*ns, 3, "", log);
+  ASSERT_TRUE(net.ok());
+  ASSERT_TRUE(net.waitReady()) << readText(log);
+  const std::uint16_t tci = 0xA00C;  // priority 5, VLAN 12
+  std::array<std::uint8_t, kMaxFrameSize> buf{};
+  FrameBuilder b(buf,
+                 EthernetHeader{kBroadcastMac, {0x02, 0, 0, 0, 0, 7}, tci, kEtherTypeEtherCat});
+  ASSERT_TRUE(b.add(Command::kBrd, 0x5A, 0, std::vector<std::uint8_t>{0, 0}).ok());
+  const auto len = b.finish();
+  ASSERT_TRUE(len.ok());
+  ASSERT_TRUE(net.link().send(ConstBytes(buf.data(), *len)).ok());
+  std::optional<EthernetHeader> header;
+  std::uint16_t wkc = 0;
+  std::array<std::uint8_t, kMaxFrameSize> answer{};
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (!header && std::chrono::steady_clock::now() < deadline) {
+    auto n = net.link().receive(answer, std::chrono::milliseconds(20));
+    if (!n.ok() || *n == 0 || answer[6] != 0x02 || answer[11] != 7) continue;
+    auto frame = EtherCatFrame::parse(std::span(answer.data(), *n));
+    if (!frame.ok() || (*frame->begin()).index() != 0x5A) continue;
+    header = frame->ethernet();
+    wkc = (*frame->begin()).wkc();
+  }
+  ASSERT_TRUE(header) << "no answer to the tagged frame";
+  ASSERT_TRUE(header->vlanTci.has_value()) << "answered without the VLAN tag";
+  EXPECT_EQ(*header->vlanTci, tci);
+  EXPECT_EQ(wkc, 3);
+  ASSERT_TRUE(net.child().kill(SIGINT).ok());
+  ASSERT_TRUE(net.child().wait(kExitWait).ok());
+  if (!HasFailure()) std::filesystem::remove(log);
+}
+
+// `--pcap-malformed FILE`: the frames the simulator dropped as malformed, as they came, in a
+// capture of their own (classic pcap has no per-record flag: the file is the flag), so a
+// master's bad frames can be looked at in Wireshark.
+TEST(ServeVethCapture, MalformedFramesGoToTheirOwnCapture) {
+  ECSIM_REQUIRE_NETWORK();
+  auto ns = VethNamespace::create();
+  ASSERT_TRUE(ns.ok()) << ns.error().message();
+  const std::string bad = uniqueTempPath("serve_malformed.pcap");
+  const std::string log = uniqueTempPath("serve_malformed.log");
+  ServedNetwork net(*ns, 2, "", log, {"--pcap-malformed", bad});
+  ASSERT_TRUE(net.ok());
+  ASSERT_TRUE(net.waitReady()) << readText(log);
+  std::vector<std::vector<std::uint8_t>> sent;
+  for (std::uint8_t i = 0; i < 3; ++i) {
+    // EtherCAT type 1 with a datagram that claims 0x7FF bytes in a 60-byte frame.
+    std::vector<std::uint8_t> frame(60, 0);
+    for (std::size_t k = 0; k < 6; ++k) frame[k] = 0xFF;
+    frame[6] = 0x02;
+    frame[11] = static_cast<std::uint8_t>(0x40 + i);
+    writeBe16(frame, 12, kEtherTypeEtherCat);
+    writeLe16(frame, 14, 0x1000 | 50);
+    writeLe16(frame, 22, 0x7FF);
+    ASSERT_TRUE(net.link().send(frame).ok());
+    sent.push_back(frame);
+  }
+  ASSERT_TRUE(net.datagram(Command::kBrd, 0, {0, 0})) << "still answering";
+  ASSERT_TRUE(net.child().kill(SIGINT).ok());
+  auto code = net.child().wait(kExitWait);
+  ASSERT_TRUE(code.ok());
+  EXPECT_EQ(*code, 0) << readText(log);
+  auto records = PcapReader::readAll(bad);
+  ASSERT_TRUE(records.ok()) << records.error().message();
+  ASSERT_EQ(records->size(), sent.size()) << "only the malformed frames, each once";
+  for (std::size_t i = 0; i < sent.size(); ++i) EXPECT_EQ((*records)[i].data, sent[i]);
+  if (!HasFailure()) {
+    std::filesystem::remove(bad);
+    std::filesystem::remove(log);
+  }
+}
+
+// Captures you can trust after a crash. A server that answered and then idled has its records
+// on disk (it wrote 0 bytes before), and SIGKILL in the middle of traffic leaves a file that
+// capinfos reads without error (it ended in a torn record before): whole records only.
+TEST(ServeVethCapture, SigkillDuringTrafficLeavesACaptureCapinfosReads) {
+  ECSIM_REQUIRE_NETWORK();
+  REQUIRE_TOOL((std::vector<std::string>{"capinfos", "-h"}), "capinfos");
+  auto ns = VethNamespace::create();
+  ASSERT_TRUE(ns.ok()) << ns.error().message();
+  const std::string pcap = uniqueTempPath("serve_kill.pcap");
+  const std::string log = uniqueTempPath("serve_kill.log");
+  std::filesystem::remove(pcap);
+  // SIGKILL leaves the control socket behind: in the temporary folder, removed below.
+  const std::string control = uniqueTempPath("serve_kill.sock");
+  ServedNetwork net(*ns, 2, pcap, log, {"--control", control});
+  ASSERT_TRUE(net.ok());
+  ASSERT_TRUE(net.waitReady()) << readText(log);
+  for (int i = 0; i < 10; ++i) ASSERT_TRUE(net.datagram(Command::kBrd, 0, {0, 0}));
+  // Idle now: every answered frame and its request reach the file without any further frame.
+  auto recordsOnDisk = [&] {
+    auto records = PcapReader::readAll(pcap);
+    return records.ok() ? records->size() : std::size_t{0};
+  };
+  EXPECT_TRUE(waitUntil([&] { return recordsOnDisk() >= 20; }))
+      << "an idle server keeps its records buffered: " << recordsOnDisk() << " on disk";
+  const std::size_t beforeTraffic = recordsOnDisk();
+  // Traffic, and SIGKILL in its middle.
+  std::array<std::uint8_t, kMaxFrameSize> buf{};
+  FrameBuilder b(
+      buf, EthernetHeader{kBroadcastMac, {0x02, 0, 0, 0, 0, 1}, std::nullopt, kEtherTypeEtherCat});
+  ASSERT_TRUE(b.add(Command::kBrd, 1, 0, std::vector<std::uint8_t>{0, 0}).ok());
+  const auto len = b.finish();
+  ASSERT_TRUE(len.ok());
+  std::array<std::uint8_t, kMaxFrameSize> answer{};
+  SimTime killedAt = 0;
+  for (int i = 0; i < 4000; ++i) {
+    (void)net.link().send(ConstBytes(buf.data(), *len));
+    (void)net.link().receive(answer, std::chrono::microseconds(i % 2 == 0 ? 0 : 200));
+    if (i == 2000) {
+      killedAt = WallClock().now();
+      ASSERT_TRUE(net.child().kill(SIGKILL).ok());
+    }
+  }
+  auto code = net.child().wait(kExitWait);
+  ASSERT_TRUE(code.ok());
+  EXPECT_EQ(*code, 128 + SIGKILL);
+  auto info = runCommand({"capinfos", "-c", pcap});
+  ASSERT_TRUE(info.ok());
+  EXPECT_EQ(info->exitCode, 0) << info->output;
+  EXPECT_EQ(info->output.find("error"), std::string::npos) << info->output;
+  auto records = PcapReader::readAll(pcap);
+  ASSERT_TRUE(records.ok()) << records.error().message();
+  EXPECT_GT(records->size(), beforeTraffic) << "records of the traffic before the kill";
+  if (!records->empty() && killedAt > 0) {
+    // A figure, not a pass/fail: how much before the kill the last record on disk was stamped.
+    std::printf("capture after SIGKILL: %zu records, the last one %.1f ms before the kill\n",
+                records->size(), static_cast<double>(killedAt - records->back().timestampNs) / 1e6);
+  }
+  std::filesystem::remove(control);
+  if (!HasFailure()) {
+    std::filesystem::remove(pcap);
+    std::filesystem::remove(log);
+  }
+}
+
+// `--pcap` on a full device: reported at once (the header is written at open), exit status 1;
+// it used to serve on, losing every record, and exit 0.
+TEST(ServeVethCapture, FullDeviceIsReportedAtOnceWithAFailingExitStatus) {
+  ECSIM_REQUIRE_NETWORK();
+  if (!std::filesystem::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  auto ns = VethNamespace::create();
+  ASSERT_TRUE(ns.ok()) << ns.error().message();
+  const std::string log = uniqueTempPath("serve_full.log");
+  ServedNetwork net(*ns, 1, "/dev/full", log);
+  ASSERT_TRUE(net.ok());
+  auto code = net.child().wait(kExitWait);
+  if (!code.ok()) (void)net.child().stop();
+  ASSERT_TRUE(code.ok()) << "still serving with a capture that loses everything";
+  EXPECT_NE(*code, 0);
+  const std::string out = readText(log);
+  EXPECT_NE(out.find("/dev/full"), std::string::npos) << out;
+  EXPECT_NE(out.find("No space left"), std::string::npos) << out;
+  if (!HasFailure()) std::filesystem::remove(log);
 }
 
 }  // namespace

@@ -41,7 +41,8 @@ struct ServeOptions {
   std::string tap;
   std::string netns;
   std::string pcap;
-  unsigned slaves{0};  // 0: not given
+  std::string pcapMalformed;  // malformed frames the simulator dropped, to their own capture
+  unsigned slaves{0};         // 0: not given
   bool paced{false};
   bool quiet{false};
   bool realtime{false};
@@ -152,11 +153,14 @@ int runServe(ServeOptions o) {
     }
     captures.emplace_back(spec.substr(0, eq), spec.substr(eq + 1));
   }
+  if (!o.pcapMalformed.empty()) captures.emplace_back("", o.pcapMalformed);
+  // Each writer's header is on disk once opened (a full disk fails here, before serving).
   std::vector<std::unique_ptr<PcapWriter>> writers;
   std::vector<std::unique_ptr<topology::PcapCableTap>> taps;
+  topology::CableObserver* malformedTap = nullptr;
   for (const auto& [cable, file] : captures) {
-    const topology::CableRef* ref = network.findCable(cable);
-    if (ref == nullptr) {
+    const topology::CableRef* ref = cable.empty() ? nullptr : network.findCable(cable);
+    if (!cable.empty() && ref == nullptr) {
       fmt::print(stderr, "ecsim serve: no cable named '{}' in the topology\n", cable);
       return 2;
     }
@@ -167,7 +171,11 @@ int runServe(ServeOptions o) {
     }
     writers.push_back(std::make_unique<PcapWriter>(std::move(w).value()));
     taps.push_back(std::make_unique<topology::PcapCableTap>(*writers.back(), unixOffset));
-    segment.setCableObserver(ref->slave, ref->port, taps.back().get());
+    if (ref != nullptr) {
+      segment.setCableObserver(ref->slave, ref->port, taps.back().get());
+    } else {
+      malformedTap = taps.back().get();
+    }
   }
   Link* served = link.get();
 
@@ -189,6 +197,7 @@ int runServe(ServeOptions o) {
   topology::ServerOptions options;
   options.paced = o.paced;
   options.idleWait = std::chrono::milliseconds(10);
+  options.malformedObserver = malformedTap;
   topology::NetworkServer server(*served, segment, clock, options);
   SignalFlag stop;
   if (!o.quiet) {
@@ -216,12 +225,29 @@ int runServe(ServeOptions o) {
     auto done = faults.apply(*action, clock.now());
     return done.ok() ? "ok " + *done : "error " + done.error().context;
   };
+  // Captures reach the disk when the server idles and at least every kCaptureFlushInterval
+  // under traffic; a capture error is reported at once and fails the run (it serves on).
+  bool captureFailed = false;
+  auto reportCapture = [&](const Status& s) {
+    if (s.ok() || captureFailed) return;
+    captureFailed = true;
+    fmt::print(stderr, "ecsim serve: capture failed, serving on without it: {}\n",
+               s.error().message());
+    std::fflush(stderr);
+  };
+  std::uint64_t receivedBefore = 0;
   auto status = server.run([&] {
     if (control.ok()) control->poll(handle, clock.now());
     reporter.tick(clock.now(), segment, server.counters());
+    const bool idle = server.counters().framesReceived == receivedBefore;
+    receivedBefore = server.counters().framesReceived;
+    for (std::size_t i = 0; i < writers.size(); ++i) {
+      reportCapture(taps[i]->status());
+      reportCapture(idle ? writers[i]->flush() : writers[i]->flushIfDue(clock.now()));
+    }
     return stop.raised();
   });
-  for (auto& w : writers) (void)w->close();
+  for (auto& w : writers) reportCapture(w->close());
   const auto& c = server.counters();
   const auto& sc = segment.counters();
   fmt::print(
@@ -233,7 +259,7 @@ int runServe(ServeOptions o) {
     fmt::print(stderr, "ecsim serve: {}\n", status.error().message());
     return 1;
   }
-  return 0;
+  return captureFailed ? 1 : 0;
 }
 
 }  // namespace
@@ -255,6 +281,8 @@ CommandRunner addServeCommand(CLI::App& app) {
   cmd->add_option("--slaves", opts->slaves, "Serve a line of N generic slaves instead")
       ->check(CLI::Range(1u, 65535u));
   cmd->add_option("--pcap", opts->pcap, "Capture every frame to this pcap file");
+  cmd->add_option("--pcap-malformed", opts->pcapMalformed,
+                  "Capture the malformed frames the simulator dropped to this pcap file");
   cmd->add_option("--control", opts->control,
                   "Control socket for live fault injection (default /run/ecsim/IFACE.sock)");
   cmd->add_flag("--paced", opts->paced, "Answer at the modelled round-trip time");
