@@ -19,27 +19,19 @@
 #include "slavesim/devices/device_state.hpp"
 #include "support/privileges.hpp"
 #include "tests/slavesim/drive_test_support.hpp"
+#include "tests/slavesim/temp_dir.hpp"
 
 namespace ecsim::testing {
 namespace {
 
-class StateFileSafety : public ::testing::Test {
+class StateFileSafety : public TempDir {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = std::filesystem::temp_directory_path() /
-           ("ecsim-state-" + std::to_string(::getpid()) + "-" + info->name());
-    std::filesystem::remove_all(dir_);
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
   static std::string contents(const std::filesystem::path& p) {
     std::ifstream in(p);
     std::stringstream s;
     s << in.rdbuf();
     return s.str();
   }
-  std::filesystem::path dir_;
 };
 
 std::string errorOf(const Status& s) { return s.ok() ? "(saved)" : s.error().context; }
