@@ -14,7 +14,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <optional>
-#include <regex>
 #include <thread>
 #include <vector>
 
@@ -27,6 +26,7 @@
 #include "protocol/al_status.hpp"
 #include "protocol/frame.hpp"
 #include "protocol/registers.hpp"
+#include "scenario/command_output.hpp"
 #include "topology/faults.hpp"
 #include "topology/network_builder.hpp"
 #include "topology/network_server.hpp"
@@ -35,7 +35,7 @@
 namespace ecsim::scenario {
 namespace {
 
-constexpr SimTime kNoTime = INT64_MIN;
+constexpr SimTime kNoTime = kNoTimeZero;
 constexpr auto kIdleWait = std::chrono::microseconds(500);  // timeline resolution when idle
 constexpr auto kPollInterval = std::chrono::milliseconds(5);
 constexpr auto kServingTimeout = std::chrono::seconds(30);  // the simulator's thread starting
@@ -57,60 +57,6 @@ std::string stateText(std::uint16_t status, std::uint16_t code) {
   if ((status & 0x10) != 0) s += fmt::format("+ERR {:#06x} ({})", code, alStatusCodeText(code));
   return s;
 }
-
-std::string excerpt(std::string_view line) {
-  constexpr std::size_t kMax = 100;
-  if (line.size() <= kMax) return "'" + std::string(line) + "'";
-  return "'" + std::string(line.substr(0, kMax)) + "...'";
-}
-
-struct StampedLine {
-  SimTime at{0};  // RealClock time the line was first seen complete
-  std::string text;
-};
-
-// Reads the command's output file while it grows and stamps each line with the time it was
-// first seen. SOEM ends its cyclic lines with '\r', so '\r' ends a line too; empty lines are
-// left out. A program that buffers its output shows its lines late (stdbuf -oL helps).
-class OutputReader {
- public:
-  explicit OutputReader(std::filesystem::path path) : path_(std::move(path)) {}
-  void poll(SimTime now) {
-    if (!fd_.valid()) {
-      fd_ = UniqueFd(::open(path_.c_str(), O_RDONLY | O_CLOEXEC));
-      if (!fd_.valid()) return;
-    }
-    std::array<char, 4096> chunk{};
-    for (;;) {
-      const ssize_t n = ::read(fd_.get(), chunk.data(), chunk.size());
-      if (n <= 0) break;
-      for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) {
-        const char c = chunk[i];
-        if (c == '\n' || c == '\r') {
-          endLine(now);
-        } else {
-          pending_ += c;
-        }
-      }
-    }
-  }
-  // Reads what is left; a last line without its end counts too.
-  void finish(SimTime now) {
-    poll(now);
-    endLine(now);
-  }
-  const std::vector<StampedLine>& lines() const { return lines_; }
-
- private:
-  void endLine(SimTime now) {
-    if (!pending_.empty()) lines_.push_back({now, std::move(pending_)});
-    pending_.clear();
-  }
-  std::filesystem::path path_;
-  UniqueFd fd_;
-  std::string pending_;
-  std::vector<StampedLine> lines_;
-};
 
 // Counts the frames that carry process data (LRW, LRD or LWR) on their way in: an external
 // master's cycles as the simulator sees them. Used by the server's thread only.
@@ -162,7 +108,7 @@ class ExternalRun {
   // Main thread, after the server thread has ended.
   void finish(SimTime end, const std::string& endText);
   ExpectationResult evaluateBackInOp(std::size_t i, SimTime end) const;
-  ExpectationResult evaluateCommand(const Expectation& x, SimTime end) const;
+  ExpectationResult evaluateCommand(std::size_t index, SimTime end) const;
   void log(SimTime at, std::string text) { log_.push_back({at, std::move(text)}); }
 
   const Scenario& s_;
@@ -198,7 +144,7 @@ class ExternalRun {
   std::optional<int> exitStatus_;
   std::string exitHow_;
   SimTime commandStart_{0};
-  std::vector<StampedLine> output_;
+  std::optional<CommandOutput> output_;
 };
 
 bool ExternalRun::allOp() const {
@@ -342,7 +288,8 @@ ExpectationResult ExternalRun::evaluateBackInOp(std::size_t i, SimTime end) cons
   return res;
 }
 
-ExpectationResult ExternalRun::evaluateCommand(const Expectation& x, SimTime at) const {
+ExpectationResult ExternalRun::evaluateCommand(std::size_t index, SimTime at) const {
+  const auto& x = s_.expectations[index];
   ExpectationResult res{x.line, x.describe(), false, at, {}, x.needsRecovery};
   if (x.kind == ExpectKind::kExitStatus) {
     if (!exitStatus_) {
@@ -353,25 +300,14 @@ ExpectationResult ExternalRun::evaluateCommand(const Expectation& x, SimTime at)
     res.observed = fmt::format("exit status {}{}", *exitStatus_, exitHow_);
     return res;
   }
-  std::optional<std::regex> re;
-  if (x.isRegex) re.emplace(x.text, std::regex::ECMAScript);  // checked when the file was read
   const SimTime zero = zero_.load();
   if (x.afterTime && zero == kNoTime) {
     res.observed = "the network never had all slaves in OP: no time zero to count afterMs from";
     return res;
   }
-  std::size_t found = 0;
-  const StampedLine* first = nullptr;
-  for (const auto& line : output_) {
-    if (x.afterTime &&
-        (line.at - zero < *x.afterTime || line.at - zero > *x.afterTime + x.within)) {
-      continue;
-    }
-    if (re ? !std::regex_search(line.text, *re) : line.text.find(x.text) == std::string::npos) {
-      continue;
-    }
-    if (found++ == 0) first = &line;
-  }
+  const OutputTally& tally = output_->tallies()[index];
+  const std::size_t found = tally.found;
+  const std::optional<StampedLine>& first = tally.first;
   if (x.countLines) {
     res.passed = compareValues(static_cast<double>(found), x.compare, x.value, x.tolerance);
   } else {
@@ -380,12 +316,13 @@ ExpectationResult ExternalRun::evaluateCommand(const Expectation& x, SimTime at)
   const std::string window = x.afterTime ? fmt::format(" seen from {} to {}", ms(*x.afterTime),
                                                        ms(*x.afterTime + x.within))
                                          : std::string();
-  if (first == nullptr) {
-    res.observed = fmt::format("not found in the {} lines of output{}", output_.size(), window);
+  if (!first) {
+    res.observed =
+        fmt::format("not found in the {} lines of output{}", output_->lineCount(), window);
   } else {
     const SimTime origin = zero == kNoTime ? commandStart_ : zero;
-    res.observed = fmt::format("{} of {} lines{}, the first at {}: {}", found, output_.size(),
-                               window, ms(first->at - origin), excerpt(first->text));
+    res.observed = fmt::format("{} of {} lines{}, the first at {}: '{}'", found,
+                               output_->lineCount(), window, ms(first->at - origin), first->text);
   }
   return res;
 }
@@ -415,7 +352,7 @@ void ExternalRun::finish(SimTime end, const std::string& endText) {
         r_.results.push_back(evaluateBackInOp(i, end));
       }
     } else if (x.kind == ExpectKind::kExitStatus || x.kind == ExpectKind::kOutput) {
-      r_.results.push_back(evaluateCommand(x, since));
+      r_.results.push_back(evaluateCommand(i, since));
     } else if (!checked_[i]) {
       if (!x.atCycle && !x.atTime) {
         r_.results.push_back(evaluatePoint(x, since));
@@ -531,7 +468,12 @@ ScenarioResult ExternalRun::execute() {
   }
   std::error_code ignored;
   std::filesystem::remove(outputFile, ignored);  // no line of an earlier run is read
-  OutputReader reader(outputFile);
+  auto output = CommandOutput::open(outputFile, s_.expectations, e_.tailLines);
+  if (!output.ok()) {
+    r_.error = fmt::format("{}: {}", s_.file.string(), output.error().message());
+    return r_;
+  }
+  output_.emplace(std::move(*output));
   const SimTime start = clock_.now();
   commandStart_ = start;
   if (s_.timeFromStart) zero_ = start;
@@ -570,7 +512,7 @@ ScenarioResult ExternalRun::execute() {
                             number(static_cast<double>(s_.startTimeout) / kNsPerMs));
       break;
     }
-    reader.poll(now);
+    output_->poll(now, zero_.load());
     std::this_thread::sleep_for(kPollInterval);
   }
   if (!exitStatus_) {
@@ -590,17 +532,26 @@ ScenarioResult ExternalRun::execute() {
   thread.join();
   if (writer) (void)writer->close();
 
-  reader.finish(end);
-  output_ = reader.lines();
+  output_->finish(end, zero_.load());
   if (!keepOutput) std::filesystem::remove(outputFile, ignored);
 
   if (!schedulingNote_.empty()) log(start, "note: " + schedulingNote_);
   finish(end, endText);
-  const std::size_t tail = std::min(e_.tailLines, output_.size());
-  r_.log.push_back(fmt::format("  output: last {} of {} lines{}", tail, output_.size(),
+  const auto& tail = output_->tail();
+  r_.log.push_back(fmt::format("  output: last {} of {} lines{}", tail.size(),
+                               output_->lineCount(),
                                keepOutput ? ", all in " + outputFile.string() : ""));
-  for (std::size_t i = output_.size() - tail; i < output_.size(); ++i) {
-    r_.log.push_back("    | " + output_[i].text);
+  if (output_->cutLines() > 0) {
+    r_.log.push_back(fmt::format("  output: {} lines longer than {} bytes, judged in pieces of "
+                                 "that size",
+                                 output_->cutLines(), kMaxOutputLine));
+  }
+  constexpr std::size_t kShownLine = 1000;  // bytes of a tail line in the report
+  for (const auto& line : tail) {
+    r_.log.push_back("    | " + (line.size() <= kShownLine
+                                     ? line
+                                     : line.substr(0, kShownLine) +
+                                           fmt::format("... ({} bytes)", line.size())));
   }
   if (interrupted) {
     r_.error = fmt::format("interrupted by signal {} ({}): the command was stopped",

@@ -8,9 +8,10 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
-#include <regex>
+#include <sstream>
 
 #include "protocol/read_file.hpp"
+#include "scenario/command_output.hpp"
 #include "scenario/scenario.hpp"
 
 namespace ecsim::scenario {
@@ -220,12 +221,10 @@ Result<Expectation> readExpectation(const Reader& r, const XMLElement* e) {
         return r.error(e, "Output with op=\"...\" needs value=\"N\" (a number of lines)");
       }
       if (x.isRegex) {
-        // std::regex reports a bad pattern only by throwing: caught here, at file loading.
-        try {
-          std::regex check(x.text, std::regex::ECMAScript);
-        } catch (const std::regex_error& bad) {
-          return r.error(e,
-                         "matches=\"" + x.text + "\" is not a regular expression: " + bad.what());
+        if (auto p = OutputPattern::compile(x.text); !p.ok()) {
+          const std::string shown =
+              x.text.size() > 60 ? x.text.substr(0, 60) + "..." : x.text;
+          return r.error(e, "matches=\"" + shown + "\": " + p.error().context);
         }
       }
     }

@@ -87,12 +87,9 @@ Status Cia402Drive::init() {
 
   double angle = params_.initialShaftAngle;
   if (!params_.stateFile.empty()) {
-    auto loaded = loadDeviceState(params_.stateFile);
-    if (loaded.ok()) {
-      angle = loaded->shaftAngle;
-    } else if (loaded.error().code != ErrorCode::kNotFound) {
-      return loaded.takeError();
-    }
+    ECSIM_ASSIGN_OR_RETURN(auto file, DeviceStateFile::open(params_.stateFile));
+    if (file.loaded()) angle = file.loaded()->shaftAngle;
+    stateSaver_.emplace(std::move(file), params_.stateSaveInterval);
   }
   axis_.motor().setAngle(angle);
   encoder_.powerOn(angle);
@@ -110,8 +107,8 @@ Cia402Drive::~Cia402Drive() {
 }
 
 Status Cia402Drive::saveState() const {
-  if (params_.stateFile.empty()) return okStatus();
-  return saveDeviceState(params_.stateFile, DeviceState{axis_.motor().angle()});
+  if (!stateSaver_) return okStatus();
+  return stateSaver_->save(DeviceState{axis_.motor().angle()});
 }
 
 double Cia402Drive::velocity() const {
@@ -166,6 +163,7 @@ void Cia402Drive::cycle(AlState al, SimTime now) {
   const SimTime dt = now > lastNow_ ? now - lastNow_ : 0;
   lastNow_ = std::max(lastNow_, now);
   advance(dt);
+  if (stateSaver_) (void)stateSaver_->tick(lastNow_, DeviceState{axis_.motor().angle()});
   takeCommands(al);
   publish(now);
 }

@@ -41,7 +41,8 @@
 //  - transitions 5, 8 and 9 switch the power stage off at once (the motor coasts).
 //  - position is the encoder count plus the home offset; 0x6064 wraps at 32 bits. The shaft
 //    angle is kept in DriveParams::stateFile (read at creation; written when the power stage
-//    goes off, on AL state changes, by saveState() and when the drive is destroyed).
+//    goes off, on AL state changes, by saveState(), when the drive is destroyed, and every
+//    stateSaveInterval of simulated time while the shaft moves, so kill -9 loses at most that).
 #pragma once
 
 #include <cstdint>
@@ -53,6 +54,7 @@
 #include "protocol/coe.hpp"
 #include "protocol/result.hpp"
 #include "slavesim/devices/cia402.hpp"
+#include "slavesim/devices/device_state.hpp"
 #include "slavesim/devices/encoder.hpp"
 #include "slavesim/devices/motion_profile.hpp"
 #include "slavesim/devices/object_ref.hpp"
@@ -77,6 +79,7 @@ struct DriveParams {
   SimTime faultReactionTimeout{500 * kNsPerMs};  // longest fault reaction
   double initialShaftAngle{0.0};                 // rad, when there is no state file yet
   std::filesystem::path stateFile;               // empty: nothing kept
+  SimTime stateSaveInterval{100 * kNsPerMs};     // periodic saves while moving; 0: none
   // Initial values of the dictionary's 0x6065 (counts), 0x6066 (ms) and 0x6072 (per mille);
   // unset: the ESI defaults.
   std::optional<std::uint32_t> followingErrorWindow;
@@ -211,6 +214,7 @@ class Cia402Drive : public Application {
   SimTime clock_{0};  // time of the motor model (the start of the next substep)
   SimTime readyAt_{0};
   AlState lastAl_{AlState::kInit};
+  std::optional<PeriodicStateSaver> stateSaver_;
 
   EncoderReading reading_{};
   std::int64_t offset_{0};  // drive position = encoder count + offset_

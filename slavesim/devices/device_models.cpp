@@ -120,7 +120,8 @@ Status attachDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,
     case DeviceModelKind::kRobotDrive:
       return installDrive(device, RobotDrive::create(od, drive), options.emergencies);
     case DeviceModelKind::kSsiEncoder: {
-      EncoderTerminalOptions encoder{drive.encoder, drive.initialShaftAngle, drive.stateFile};
+      EncoderTerminalOptions encoder{drive.encoder, drive.initialShaftAngle, drive.stateFile,
+                                     drive.stateSaveInterval};
       ECSIM_ASSIGN_OR_RETURN(auto terminal, SsiEncoderTerminal::create(od, encoder));
       ECSIM_TRY(applyScripts(*terminal, options.scripts));
       device.setApplication(std::move(terminal));
@@ -304,6 +305,9 @@ Result<bool> applyPlain(DeviceModelOptions& o, const DeviceParam& p) {
   } else if (n == "drive.initTimeMs") {
     ECSIM_ASSIGN_OR_RETURN(auto ms, integer<std::int64_t>(p, 0, 3'600'000));
     o.drive.initTime = ms * kNsPerMs;
+  } else if (n == "drive.stateSaveIntervalMs") {
+    ECSIM_ASSIGN_OR_RETURN(auto ms, integer<std::int64_t>(p, 0, 3'600'000));
+    o.drive.stateSaveInterval = ms * kNsPerMs;
   } else if (n == "drive.faultReactionTimeoutMs") {
     ECSIM_ASSIGN_OR_RETURN(auto ms, integer<std::int64_t>(p, 0, 3'600'000));
     o.drive.faultReactionTimeout = ms * kNsPerMs;

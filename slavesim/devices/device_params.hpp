@@ -15,7 +15,8 @@
 //   drive.*    followingErrorWindow (counts, 0x6065), followingErrorTimeout (ms, 0x6066),
 //              torqueLimit (per mille of rated torque, 0x6072), quickStopDeceleration
 //              (counts/s^2), homeOffset (counts), initialShaftAngle (rad), initTimeMs,
-//              faultReactionTimeoutMs
+//              faultReactionTimeoutMs, stateSaveIntervalMs (simulated ms between saves of
+//              the stateFile while the shaft moves, default 100; 0: on state changes only)
 //   analog.*   fullScaleVolts, conversionPeriodUs
 //   signal.N   input terminals: channel N driven by a script in the text form of signal.hpp
 //              ("square period=0.5", "sine amplitude=5 frequency=2", "csv file=trace.csv"),

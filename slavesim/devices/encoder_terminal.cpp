@@ -26,12 +26,9 @@ Result<std::unique_ptr<SsiEncoderTerminal>> SsiEncoderTerminal::create(
   std::unique_ptr<SsiEncoderTerminal> t(new SsiEncoderTerminal(options));
   double angle = options.initialShaftAngle;
   if (!options.stateFile.empty()) {
-    auto loaded = loadDeviceState(options.stateFile);
-    if (loaded.ok()) {
-      angle = loaded->shaftAngle;
-    } else if (loaded.error().code != ErrorCode::kNotFound) {
-      return loaded.takeError();
-    }
+    ECSIM_ASSIGN_OR_RETURN(auto file, DeviceStateFile::open(options.stateFile));
+    if (file.loaded()) angle = file.loaded()->shaftAngle;
+    t->stateSaver_.emplace(std::move(file), options.stateSaveInterval);
   }
   for (unsigned c = 0; c < kMaxChannels; ++c) {
     const auto index = static_cast<std::uint16_t>(kInputBase + kChannelStride * c);
@@ -63,8 +60,8 @@ SsiEncoderTerminal::~SsiEncoderTerminal() {
 }
 
 Status SsiEncoderTerminal::saveState() const {
-  if (options_.stateFile.empty() || channels_.empty()) return okStatus();
-  return saveDeviceState(options_.stateFile, DeviceState{channels_.front().angle});
+  if (!stateSaver_ || channels_.empty()) return okStatus();
+  return stateSaver_->save(DeviceState{channels_.front().angle});
 }
 
 void SsiEncoderTerminal::setShaftAngle(unsigned channel, double rad) {
@@ -128,6 +125,7 @@ void SsiEncoderTerminal::latch(SimTime now) {
   }
   errorRegisterValue_ = reg;
   errorRegister_.set(reg);
+  if (stateSaver_) (void)stateSaver_->tick(now, DeviceState{channels_.front().angle});
 }
 
 }  // namespace ecsim::slavesim::devices

@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "protocol/result.hpp"
+#include "slavesim/devices/device_state.hpp"
 #include "slavesim/devices/encoder.hpp"
 #include "slavesim/devices/object_ref.hpp"
 #include "slavesim/devices/signal.hpp"
@@ -59,6 +60,7 @@ struct EncoderTerminalOptions {
   EncoderParams encoder;
   double initialShaftAngle{0.0};    // rad, every channel, when there is no state file yet
   std::filesystem::path stateFile;  // channel 1's shaft angle, kept across restarts
+  SimTime stateSaveInterval{100 * kNsPerMs};  // periodic saves while it turns; 0: none
 };
 
 class SsiEncoderTerminal final : public Application {
@@ -117,6 +119,7 @@ class SsiEncoderTerminal final : public Application {
   ObjectRef errorRegister_;  // 0x1001, when present
   std::uint8_t errorRegisterValue_{0};
   SimTime lastLatch_{0};
+  std::optional<PeriodicStateSaver> stateSaver_;
   bool latched_{false};
 };
 

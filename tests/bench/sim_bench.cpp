@@ -3,9 +3,15 @@
 // them) plus the DC FRMW distribution, through lines of 10, 100 and 1000 slaves.
 // Reports ns per cycle and ns per slave; compare with the modelled wire round trip. Also the
 // time to parse and build a topology of 1,000 to 20,000 slaves (linear: the same per slave).
+// BM_DriveNetwork: the robot6 example (six drives, two joints falling under gravity) stepped
+// once per 1 ms cycle, without state files (0) and with one per drive (1), saved every 100 ms
+// of simulated time while a joint moves: the cost of the periodic saves.
 #include <benchmark/benchmark.h>
 
+#include <unistd.h>
+
 #include <array>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -134,6 +140,49 @@ BENCHMARK(BM_WireLineRefreshingEverySlavePerLink)
     ->Arg(1000)
     ->Arg(5000)
     ->Unit(benchmark::kMillisecond);
+
+
+void BM_DriveNetwork(benchmark::State& state) {
+  auto config = loadTopologyFile(std::filesystem::path(ECSIM_SOURCE_DIR) /
+                                 "examples/topologies/robot6.xml");
+  if (!config.ok()) {
+    state.SkipWithError(config.error().message().c_str());
+    return;
+  }
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("ecsim-bench-state-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::size_t files = 0;
+  if (state.range(0) != 0) {
+    for (auto& slave : config->slaves) {
+      if (slave.name.size() == 2 && slave.name[0] == 'J') {
+        slave.stateFile = dir / (slave.name + ".state");
+        ++files;
+      }
+    }
+  }
+  {
+    auto network = topology::buildNetwork(*config);
+    if (!network.ok()) {
+      state.SkipWithError(network.error().message().c_str());
+      return;
+    }
+    std::array<std::uint8_t, kMaxFrameSize> frame{};
+    FrameBuilder b(frame, EthernetHeader{});
+    (void)b.add(Command::kBrd, 0, DatagramHeader::physical(0, reg::kAlStatus.address), 2);
+    const std::size_t length = *b.finish();
+    SimTime now = 0;
+    for (auto _ : state) {
+      auto out = network->segment->processFrame(std::span(frame.data(), length), now);
+      benchmark::DoNotOptimize(out);
+      network->segment->pollSlaves(now);  // the firmware step, as the server does after a frame
+      now += 1'000'000;
+    }
+    state.counters["state_files"] = static_cast<double>(files);
+  }
+  std::filesystem::remove_all(dir);
+}
+BENCHMARK(BM_DriveNetwork)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace ecsim

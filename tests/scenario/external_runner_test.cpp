@@ -1,12 +1,16 @@
 // External masters in scenario files (docs/scenarios.md, "External masters"), without running
 // anything: the ExitStatus/Output/BackInOp afterMs additions, the <Master> timeouts, the
 // refusal of expectations that need the master's internals (each error names file and line),
-// and the command's {iface}/${NAME} expansion.
+// the command's {iface}/${NAME} expansion, and the command's output read in bounded pieces
+// and judged by RE2 (scenario/command_output.hpp).
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
 #include <map>
 
+#include "scenario/command_output.hpp"
 #include "scenario/external_runner.hpp"
 #include "scenario/scenario.hpp"
 
@@ -161,6 +165,111 @@ TEST(ExternalScenarioFile, ErrorsInTheAdditionsNameTheLine) {
                          "z.xml");
   ASSERT_FALSE(s.ok());
   EXPECT_NE(errorOf(s).find("z.xml, line 3: timeZero=\"never\""), std::string::npos) << errorOf(s);
+}
+
+// std::regex recursed per atom: a 100,000-character pattern or 20,000 nested parentheses
+// crashed the loader with SIGSEGV. Patterns are RE2 (linear time, bounded memory) and their
+// length is bounded; both refusals name the file and line.
+TEST(ExternalScenarioFile, HugeAndDeeplyNestedPatternsAreRefusedWithTheLine) {
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {std::string(100000, 'a'), "at most 4096"},
+      {std::string(20000, '(') + "a" + std::string(20000, ')'), "at most 4096"},
+      {"(?=a)b", "is not a regular expression"},  // lookahead: ECMAScript, not RE2
+      {"a{1000}{1000}", "is not a regular expression"},
+      {"(a)\\1", "is not a regular expression"},  // a backreference: ECMAScript, not RE2
+  };
+  for (const auto& [pattern, message] : bad) {
+    auto s = parseScenario(
+        wrap(kExternal, "<Expect>\n<Output matches=\"" + pattern + "\"/>\n</Expect>\n"),
+        "x.xml");
+    ASSERT_FALSE(s.ok()) << pattern.substr(0, 40);
+    EXPECT_NE(errorOf(s).find("x.xml, line 5: "), std::string::npos) << errorOf(s).substr(0, 300);
+    EXPECT_NE(errorOf(s).find(message), std::string::npos) << errorOf(s).substr(0, 300);
+    EXPECT_LT(errorOf(s).size(), 1000u) << "the error quotes the pattern in full";
+  }
+  // RE2 reads what the shipped scenarios and docs use.
+  auto s = parseScenario(
+      wrap(kExternal,
+           "<Expect>\n<Output matches=\"^ERROR : slave [56] lost$\"/>\n"
+           "<Output matches=\"^Processdata cycle +[0-9]+, WKC \\d+ \"/>\n</Expect>\n"),
+      "x.xml");
+  EXPECT_TRUE(s.ok()) << errorOf(s);
+}
+
+// The command's output is read in bounded pieces and judged line by line as it comes.
+class CommandOutputTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    path_ = std::filesystem::temp_directory_path() /
+            ("ecsim-output-" + std::to_string(::getpid()) + "-" +
+             ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".txt");
+  }
+  void TearDown() override { std::filesystem::remove(path_); }
+  static Expectation output(const std::string& text, bool regex) {
+    Expectation x;
+    x.kind = ExpectKind::kOutput;
+    x.text = text;
+    x.isRegex = regex;
+    return x;
+  }
+  std::filesystem::path path_;
+};
+
+// A 300 KB line matched by (a|b)*c crashed the judge (std::regex recursed per character).
+TEST_F(CommandOutputTest, A300KbLineIsJudgedInBoundedPieces) {
+  std::ofstream(path_) << "first\n" << std::string(300000, 'a') << "c\nlast\n";
+  const std::vector<Expectation> xs = {output("(a|b)*c", true), output("aaaa", false),
+                                       output("^first$", true)};
+  auto out = CommandOutput::open(path_, xs, 3);
+  ASSERT_TRUE(out.ok()) << out.error().message();
+  out->finish(5, kNoTimeZero);
+  // 300,001 bytes: four pieces of 65,536 and one of 37,857.
+  EXPECT_EQ(out->lineCount(), 7u);
+  EXPECT_EQ(out->cutLines(), 1u);
+  EXPECT_EQ(out->tallies()[0].found, 1u) << "the c is in the last piece";
+  EXPECT_EQ(out->tallies()[1].found, 5u);
+  EXPECT_EQ(out->tallies()[2].found, 1u);
+  ASSERT_TRUE(out->tallies()[1].first.has_value());
+  EXPECT_EQ(out->tallies()[1].first->text, std::string(100, 'a') + "...");
+  EXPECT_EQ(out->tallies()[1].first->at, 5);
+  ASSERT_EQ(out->tail().size(), 3u);
+  EXPECT_EQ(out->tail().back(), "last");
+  for (const auto& line : out->tail()) EXPECT_LE(line.size(), kMaxOutputLine);
+}
+
+// A program that prints without end and never a newline: each poll returns after a bounded
+// read and memory stays bounded (/dev/zero stands for the program: NUL bytes without end).
+TEST_F(CommandOutputTest, OutputWithoutEndOrNewlineKeepsTheReaderBounded) {
+  const std::vector<Expectation> xs = {output("x", false)};
+  auto out = CommandOutput::open("/dev/zero", xs, 4);
+  ASSERT_TRUE(out.ok());
+  for (int poll = 0; poll < 8; ++poll) out->poll(poll, kNoTimeZero);
+  EXPECT_EQ(out->lineCount(), 8 * kMaxOutputReadPerPoll / kMaxOutputLine - 1);
+  ASSERT_EQ(out->tail().size(), 4u);
+  for (const auto& line : out->tail()) EXPECT_EQ(line.size(), kMaxOutputLine);
+  EXPECT_EQ(out->tallies()[0].found, 0u);
+}
+
+// afterMs windows count a line by when it was first seen, relative to time zero.
+TEST_F(CommandOutputTest, WindowsCountLinesByTheirTimeAfterTimeZero) {
+  std::vector<Expectation> xs = {output("lost", false)};
+  xs[0].afterTime = 1000;
+  xs[0].within = 500;
+  auto out = CommandOutput::open(path_, xs, 0);
+  ASSERT_TRUE(out.ok());
+  std::ofstream file(path_);
+  file << "lost before zero\n" << std::flush;
+  out->poll(100, kNoTimeZero);
+  file << "lost too early\n" << std::flush;
+  out->poll(900, 0);
+  file << "lost in time\n" << std::flush;
+  out->poll(1200, 0);
+  file << "lost too late\n" << std::flush;
+  out->poll(1600, 0);
+  out->finish(1700, 0);
+  EXPECT_EQ(out->lineCount(), 4u);
+  EXPECT_EQ(out->tallies()[0].found, 1u);
+  EXPECT_EQ(out->tallies()[0].first->text, "lost in time");
 }
 
 TEST(ExternalCommand, ExpandsInterfaceAndEnvironment) {

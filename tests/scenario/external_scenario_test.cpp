@@ -148,6 +148,23 @@ TEST_F(ExternalScenario, OutputLinesAreJudgedByWhenTheyAppeared) {
       << r.results[3].observed;
 }
 
+// The program under test cannot crash the judge: a 300 KB line matched by (a|b)*c made
+// std::regex recurse per character until SIGSEGV. Lines are judged in 64 KiB pieces by RE2.
+TEST_F(ExternalScenario, A300KbOutputLineIsJudgedWithoutCrashingTheRunner) {
+  ECSIM_REQUIRE_NETWORK();
+  auto s = write(
+      "<Master kind=\"external\" timeZero=\"start\" "
+      "command=\"head -c 300000 /dev/zero | tr '\\000' a; echo c\"/>",
+      "<ExitStatus value=\"0\"/>\n<Output matches=\"(a|b)*c\"/>\n"
+      "<Output matches=\"^a+$\" op=\"eq\" value=\"4\"/>\n",
+      "durationMs=\"5000\"");
+  auto r = runExternalScenario(s);
+  ASSERT_TRUE(r.error.empty()) << r.error;
+  EXPECT_TRUE(r.passed()) << formatReport(r);
+  EXPECT_NE(formatReport(r).find("1 lines longer than 65536 bytes"), std::string::npos)
+      << formatReport(r).substr(0, 2000);
+}
+
 TEST_F(ExternalScenario, ACommandStillRunningAtTheEndIsStopped) {
   ECSIM_REQUIRE_NETWORK();
   // The command would sleep 300 s; the run (300 ms after the start, plus the set-up, slow

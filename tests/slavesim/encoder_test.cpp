@@ -15,6 +15,7 @@
 
 #include "slavesim/devices/device_state.hpp"
 #include "tests/slavesim/drive_test_support.hpp"
+#include "tests/slavesim/temp_dir.hpp"
 
 namespace ecsim::testing {
 namespace {
@@ -145,19 +146,6 @@ TEST(Encoder, SeededNoiseIsReproducibleAndHasItsStandardDeviation) {
 }
 
 // ---- state file ---------------------------------------------------------------------------------
-
-class TempDir : public ::testing::Test {
- protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = std::filesystem::temp_directory_path() /
-           ("ecsim-encoder-" + std::to_string(::getpid()) + "-" + info->name());
-    std::filesystem::remove_all(dir_);
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
-  std::filesystem::path dir_;
-};
 
 using DeviceStateFile = TempDir;
 
