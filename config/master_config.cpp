@@ -90,7 +90,10 @@ Result<MasterConfig> loadMasterConfig(const std::filesystem::path& path) {
   if (!in) return makeError(ErrorCode::kIo, path.string() + ": cannot be read");
   std::ostringstream text;
   text << in.rdbuf();
-  const std::string xml = text.str();
+  return readMasterConfig(text.str(), path);
+}
+
+Result<MasterConfig> readMasterConfig(std::string_view xml, const std::filesystem::path& path) {
   tinyxml2::XMLDocument doc;
   const bool parsed = doc.Parse(xml.data(), xml.size()) == tinyxml2::XML_SUCCESS;
   if (parsed && doc.RootElement() != nullptr &&
