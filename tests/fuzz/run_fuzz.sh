@@ -5,8 +5,8 @@
 #   tests/fuzz/run_fuzz.sh [BUILD_DIR] [RUNS] [TARGET...]    (defaults: build/fuzz, 100000, all)
 #
 # BUILD_DIR is configured with the `fuzz` preset (clang++, ECSIM_FUZZ=ON) when it has no
-# CMakeCache.txt yet; only the targets named are built (none with ECSIM_FUZZ_NO_BUILD=1). docs/fuzzing.md says what each target
-# reads and how to run a long campaign.
+# CMakeCache.txt yet; only the targets named are built (none with ECSIM_FUZZ_NO_BUILD=1).
+# docs/fuzzing.md says what each target reads and how to run a long campaign.
 #
 # Seeds are gathered at run time into a scratch directory (the run never writes into the
 # repository or ../shared): the repository's own ones in tests/fuzz/corpus/<target> (frames,
@@ -72,7 +72,9 @@ max_len() {
   esac
 }
 is_xml() {
-  case $1 in fuzz_esi | fuzz_topology | fuzz_eni | fuzz_scenario | fuzz_master_config) return 0 ;; esac
+  case $1 in
+    fuzz_esi | fuzz_topology | fuzz_eni | fuzz_scenario | fuzz_master_config) return 0 ;;
+  esac
   return 1
 }
 seed_files() {

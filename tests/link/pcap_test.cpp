@@ -153,7 +153,8 @@ TEST(PcapReader, RefusesATimestampBeyondSimTime) {
   TempPath file("far-future.pcapng");
   {
     std::ofstream out(file.str(), std::ios::binary);
-    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    out.write(reinterpret_cast<const char*>(bytes.data()),
+              static_cast<std::streamsize>(bytes.size()));
   }
   auto reader = PcapReader::open(file.str());
   ASSERT_TRUE(reader.ok()) << reader.error().message();
