@@ -66,7 +66,7 @@ install(FILES ${PROJECT_BINARY_DIR}/ecsimConfig.cmake ${PROJECT_BINARY_DIR}/ecsi
 # pkg-config: the same libraries in link order; dependencies through their own .pc files.
 set(ecsim_pc_sanitize "")
 if(ECSIM_SANITIZE)
-  set(ecsim_pc_sanitize "-fsanitize=address,undefined")
+  set(ecsim_pc_sanitize "-fsanitize=${ecsim_sanitizers}")
 endif()
 # Relocatable: the prefix is found from the .pc file's own folder (pkg-config's pcfiledir).
 file(RELATIVE_PATH ecsim_pc_up /${CMAKE_INSTALL_LIBDIR}/pkgconfig /)

@@ -86,6 +86,10 @@ MasterConfig masterConfigFromEni(EniConfig eni) {
 
 Result<MasterConfig> loadMasterConfig(const std::filesystem::path& path) {
   ECSIM_ASSIGN_OR_RETURN(const std::string xml, readRegularFile(path, kMaxXmlFileBytes));
+  return readMasterConfig(xml, path);
+}
+
+Result<MasterConfig> readMasterConfig(std::string_view xml, const std::filesystem::path& path) {
   tinyxml2::XMLDocument doc;
   const bool parsed = doc.Parse(xml.data(), xml.size()) == tinyxml2::XML_SUCCESS;
   if (parsed && doc.RootElement() != nullptr &&

@@ -49,5 +49,7 @@ Result<MasterConfig> parseMasterConfig(std::string_view xml, std::string_view fi
 MasterConfig masterConfigFromEni(EniConfig eni);
 // ENI or the simple format, by root element.
 Result<MasterConfig> loadMasterConfig(const std::filesystem::path& path);
+// The same for a file's text held in memory; `path` is used in error messages.
+Result<MasterConfig> readMasterConfig(std::string_view xml, const std::filesystem::path& path);
 
 }  // namespace ecsim

@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <array>
 #include <cerrno>
+#include <cstdio>
+#include <limits>
 #include <mutex>
 #include <optional>
 
@@ -217,6 +219,15 @@ Result<std::optional<PcapFrame>> PcapReader::next() {
                                             pcap_geterr(impl_->handle));
   }
   ++impl_->frames;
+  // pcapng timestamps are 64-bit: seconds past SimTime's range (year 2262) are refused rather
+  // than wrapped. tv_usec holds nanoseconds (the reader was opened with nanosecond precision).
+  constexpr auto kMaxSeconds = std::numeric_limits<SimTime>::max() / kNsPerSecond - 1;
+  if (header->ts.tv_sec < -kMaxSeconds || header->ts.tv_sec > kMaxSeconds) {
+    return makeError(ErrorCode::kParse, impl_->path + ": frame " + std::to_string(impl_->frames) +
+                                            ": timestamp " + std::to_string(header->ts.tv_sec) +
+                                            " s is outside -" + std::to_string(kMaxSeconds) + ".." +
+                                            std::to_string(kMaxSeconds) + " s");
+  }
   PcapFrame frame;
   frame.timestampNs = static_cast<SimTime>(header->ts.tv_sec) * kNsPerSecond +
                       static_cast<SimTime>(header->ts.tv_usec);

@@ -234,6 +234,24 @@ TEST(EniTest, MasterConfigReadsEniOrTheSimpleFormat) {
   EXPECT_FALSE(simple->slaves.at(0).station);
 }
 
+// The in-memory reader (what the fuzz target feeds) picks the format by root element like the
+// file reader and names the path it is given.
+TEST(EniTest, MasterConfigFromMemoryPicksTheFormatByRoot) {
+  auto eni = readMasterConfig(
+      "<EtherCATConfig><Config><Slave><Info><Name>A</Name><PhysAddr>1001</PhysAddr>"
+      "<VendorId>2</VendorId><ProductCode>16</ProductCode></Info></Slave></Config>"
+      "</EtherCATConfig>",
+      "mem-eni.xml");
+  ASSERT_TRUE(eni.ok()) << eni.error().message();
+  ASSERT_TRUE(eni->eni);
+  EXPECT_EQ(eni->slaves.at(0).station, 1001);
+  auto simple = readMasterConfig("<EcsimMaster><Slave name=\"A\" vendor=\"2\"/></EcsimMaster>",
+                                 "mem-simple.xml");
+  ASSERT_FALSE(simple.ok());
+  EXPECT_NE(simple.error().message().find("mem-simple.xml"), std::string::npos)
+      << simple.error().message();
+}
+
 TEST(EniTest, FormatEniReadsBackToTheSameConfiguration) {
   auto eni = loadEniFile(kDemoEni);
   ASSERT_TRUE(eni.ok()) << eni.error().message();

@@ -1,34 +1,93 @@
 #!/usr/bin/env bash
-# Runs every libFuzzer target for RUNS iterations from the seed corpus; exits non-zero on any
-# crash, leak, sanitizer report or broken round-trip property.
+# Runs libFuzzer targets for RUNS iterations each from their seed corpora; exits non-zero on any
+# crash, leak, sanitizer report, timeout or broken round-trip property.
 #
-#   tests/fuzz/run_fuzz.sh [BUILD_DIR] [RUNS]      (defaults: build/fuzz, 100000)
+#   tests/fuzz/run_fuzz.sh [BUILD_DIR] [RUNS] [TARGET...]    (defaults: build/fuzz, 100000, all)
 #
 # BUILD_DIR is configured with the `fuzz` preset (clang++, ECSIM_FUZZ=ON) when it has no
-# CMakeCache.txt yet; only the fuzz targets are built. Seeds live in tests/fuzz/corpus/<target>
-# (frame: real frames from ../shared/pcap plus SOEM's first frame; mailbox: the SyncManager
-# buffers of those captures plus hand-built CoE/SDO-information messages) and are copied to a
-# scratch directory, so the run never writes into the repository.
+# CMakeCache.txt yet; only the targets named are built (none with ECSIM_FUZZ_NO_BUILD=1).
+# docs/fuzzing.md says what each target reads and how to run a long campaign.
+#
+# Seeds are gathered at run time into a scratch directory (the run never writes into the
+# repository or ../shared): the repository's own ones in tests/fuzz/corpus/<target> (frames,
+# mailboxes, control lines, a master configuration), the project's examples, scenarios and
+# topologies, and the real files of ECSIM_SHARED (default: ../shared next to the repository:
+# esi/, eeprom/, pcap/). Files longer than the target's max_len are left out for the XML
+# targets (a cut XML file only tests the parser's first error), cut by libFuzzer otherwise.
+# The XML targets get a dictionary: tests/fuzz/xml.dict plus the element and attribute names
+# of their seeds.
 set -euo pipefail
 
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 build=${1:-$repo/build/fuzz}
 runs=${2:-100000}
-targets=(fuzz_frame fuzz_mailbox fuzz_esc)
+shift $(($# < 2 ? $# : 2))
+all_targets=(fuzz_frame fuzz_mailbox fuzz_esc fuzz_esi fuzz_topology fuzz_eni fuzz_scenario
+             fuzz_master_config fuzz_control fuzz_sii fuzz_pcap)
+targets=("$@")
+if [[ ${#targets[@]} -eq 0 ]]; then targets=("${all_targets[@]}"); fi
+shared=${ECSIM_SHARED:-$repo/../shared}
 
 case $build in /*) ;; *) build=$PWD/$build ;; esac
 if ! [[ $runs =~ ^[0-9]+$ ]]; then
-  echo "usage: $0 [BUILD_DIR] [RUNS]" >&2
+  echo "usage: $0 [BUILD_DIR] [RUNS] [TARGET...]" >&2
   exit 2
 fi
-
-if [[ ! -f $build/CMakeCache.txt ]]; then
-  (cd "$repo" && cmake --preset fuzz -B "$build")
+for target in "${targets[@]}"; do
+  if ! [[ " ${all_targets[*]} " == *" $target "* ]]; then
+    echo "run_fuzz: unknown target '$target' (targets: ${all_targets[*]})" >&2
+    exit 2
+  fi
+done
+if [[ ! -d $shared ]]; then
+  echo "run_fuzz: $shared not found: the real ESI, EEPROM and capture seeds are left out" >&2
 fi
-cmake --build "$build" --target fuzz_targets
+
+# ECSIM_FUZZ_NO_BUILD=1 runs what is built: for campaigns of several targets at once in one
+# build folder (two builds at once in one folder would race).
+if [[ ${ECSIM_FUZZ_NO_BUILD:-0} != 1 ]]; then
+  if [[ ! -f $build/CMakeCache.txt ]]; then
+    (cd "$repo" && cmake --preset fuzz -B "$build")
+  fi
+  cmake --build "$build" --target "${targets[@]}"
+fi
 
 work=$(mktemp -d "${TMPDIR:-/tmp}/ecsim-fuzz.XXXXXX")
 trap 'rm -rf "$work"' EXIT
+
+# Per target: the largest input, whether it is XML (dictionary, whole seed files only), and
+# its seed files besides tests/fuzz/corpus/<name>.
+# The lengths keep each target near 1,000 runs a second or more (an XML file costs in proportion
+# to its length): the ESI target takes the real files up to 16 KiB (six of them), the ENI
+# target the 24 KiB example, the master-configuration target its own small seeds (the ENI
+# reader has its own target).
+max_len() {
+  case $1 in
+    fuzz_frame | fuzz_mailbox | fuzz_esc) echo 2048 ;;
+    fuzz_master_config) echo 4096 ;;
+    fuzz_control) echo 512 ;;  # a few lines: each costs a verb's work on the network
+    fuzz_sii | fuzz_scenario) echo 8192 ;;
+    fuzz_esi | fuzz_topology | fuzz_pcap) echo 16384 ;;
+    fuzz_eni) echo 32768 ;;
+  esac
+}
+is_xml() {
+  case $1 in
+    fuzz_esi | fuzz_topology | fuzz_eni | fuzz_scenario | fuzz_master_config) return 0 ;;
+  esac
+  return 1
+}
+seed_files() {
+  case $1 in
+    fuzz_esi) ls "$repo"/examples/esi/*.xml "$shared"/esi/*.xml ;;
+    fuzz_topology) ls "$repo"/examples/topologies/*.xml "$repo"/examples/topologies/*/*.xml \
+                      "$repo"/tests/interop/*.xml ;;
+    fuzz_eni) ls "$repo"/examples/eni/*.xml ;;
+    fuzz_scenario) ls "$repo"/scenarios/*.xml "$repo"/scenarios/*/*.xml ;;
+    fuzz_sii) ls "$shared"/eeprom/*.bin "$shared"/eeprom/*.hex ;;
+    fuzz_pcap) ls "$shared"/pcap/*.pcap "$shared"/pcap/*.pcapng ;;
+  esac 2>/dev/null || true
+}
 
 status=0
 for target in "${targets[@]}"; do
@@ -37,17 +96,36 @@ for target in "${targets[@]}"; do
     echo "run_fuzz: $binary was not built (is the compiler clang and ECSIM_FUZZ ON?)" >&2
     exit 1
   fi
-  seeds=$repo/tests/fuzz/corpus/${target#fuzz_}
+  len=$(max_len "$target")
   corpus=$work/$target
   mkdir -p "$corpus" "$work/artifacts-$target"
-  if [[ -d $seeds ]]; then cp "$seeds"/* "$corpus"/; fi
+  own=$repo/tests/fuzz/corpus/${target#fuzz_}
+  if [[ -d $own ]]; then cp "$own"/* "$corpus"/; fi
+  while IFS= read -r seed; do
+    [[ -f $seed ]] || continue
+    if is_xml "$target" && [[ $(stat -c %s "$seed") -gt $len ]]; then continue; fi
+    cp "$seed" "$corpus/$(basename "$(dirname "$seed")")-$(basename "$seed")"
+  done < <(seed_files "$target")
+  options=()
+  if is_xml "$target"; then
+    dict=$work/$target.dict
+    cp "$repo/tests/fuzz/xml.dict" "$dict"
+    cat "$corpus"/* | grep -aoE '<[A-Za-z_][A-Za-z0-9_.:-]*|[A-Za-z_][A-Za-z0-9_.:-]*="' |
+      sort -u | sed 's/"/\\"/g; s/.*/"&"/' >>"$dict"
+    options+=(-dict="$dict")
+  elif [[ $target == fuzz_control ]]; then
+    # Its network lives across inputs by design, so nearly every input leaves allocations
+    # behind and libFuzzer's per-input leak check (the input run again, then a LeakSanitizer
+    # scan) would halve the speed for nothing; leaks are still reported when the run ends.
+    options+=(-dict="$repo/tests/fuzz/control.dict" -detect_leaks=0)
+  fi
   log=$work/$target.log
   start=$SECONDS
   rc=0
   (cd "$work" && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
     UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-    "$binary" -runs="$runs" -max_len=2048 -seed=1 -print_final_stats=1 \
-    -artifact_prefix="$work/artifacts-$target/" "$corpus") >"$log" 2>&1 || rc=$?
+    "$binary" -runs="$runs" -max_len="$len" -seed=1 -timeout=60 -print_final_stats=1 \
+    "${options[@]}" -artifact_prefix="$work/artifacts-$target/" "$corpus") >"$log" 2>&1 || rc=$?
   if [[ $rc -ne 0 ]] || grep -qE 'runtime error|ERROR: (AddressSanitizer|LeakSanitizer|libFuzzer)' "$log"; then
     echo "run_fuzz: $target FAILED (exit $rc); log tail:" >&2
     tail -n 40 "$log" >&2
@@ -57,8 +135,9 @@ for target in "${targets[@]}"; do
     done
     status=1
   else
-    echo "run_fuzz: $target ok: $(grep -E '^(Done|stat::number_of_executed_units)' "$log" | head -1)" \
-      "in $((SECONDS - start)) s"
+    echo "run_fuzz: $target ok: $(grep -E '^stat::number_of_executed_units' "$log" | awk '{print $2}')" \
+      "runs, $(grep -E '^stat::peak_rss_mb' "$log" | awk '{print $2}') MB peak, $(ls "$corpus" | wc -l)" \
+      "corpus files, in $((SECONDS - start)) s"
   fi
 done
 exit $status

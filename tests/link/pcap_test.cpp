@@ -228,6 +228,37 @@ TEST(PcapReader, ReportsAMissingFile) {
   EXPECT_NE(reader.error().context.find("/nonexistent-dir-ecsim/y.pcap"), std::string::npos);
 }
 
+// A pcapng frame whose 64-bit timestamp (microseconds) lies far beyond what SimTime holds
+// (year 2262): an error naming the file and frame, not a wrapped time (found by fuzz_pcap,
+// which hit the overflow in the seconds-to-nanoseconds conversion).
+TEST(PcapReader, RefusesATimestampBeyondSimTime) {
+  auto le32 = [](std::vector<std::uint8_t>& out, std::uint32_t v) {
+    for (int i = 0; i < 4; ++i) out.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
+  };
+  std::vector<std::uint8_t> bytes;
+  // Section header block: type, length, byte-order magic, version 1.0, section length -1.
+  for (std::uint32_t v : {0x0A0D0D0Au, 28u, 0x1A2B3C4Du, 1u, 0xFFFFFFFFu, 0xFFFFFFFFu, 28u}) {
+    le32(bytes, v);
+  }
+  // Interface description block: Ethernet, snap length 0 (unlimited), microseconds.
+  for (std::uint32_t v : {1u, 20u, 1u, 0u, 20u}) le32(bytes, v);
+  // Enhanced packet block on interface 0, timestamp 0xFFFFFFFF'00000000 us, 4 bytes of data.
+  for (std::uint32_t v : {6u, 36u, 0u, 0xFFFFFFFFu, 0u, 4u, 4u, 0x04030201u, 36u}) le32(bytes, v);
+  TempPath file("far-future.pcapng");
+  {
+    std::ofstream out(file.str(), std::ios::binary);
+    out.write(reinterpret_cast<const char*>(bytes.data()),
+              static_cast<std::streamsize>(bytes.size()));
+  }
+  auto reader = PcapReader::open(file.str());
+  ASSERT_TRUE(reader.ok()) << reader.error().message();
+  auto frame = reader->next();
+  ASSERT_FALSE(frame.ok());
+  EXPECT_NE(frame.error().context.find(file.str()), std::string::npos) << frame.error().message();
+  EXPECT_NE(frame.error().context.find("frame 1"), std::string::npos) << frame.error().message();
+  EXPECT_NE(frame.error().context.find("timestamp"), std::string::npos) << frame.error().message();
+}
+
 // Real captures from ../shared/pcap (MANIFEST.md gives their frame counts; first timestamps
 // and EtherTypes as printed by `tshark -T fields -e frame.time_epoch -e eth.type`).
 TEST(PcapReader, ReadsRealPcapngCaptures) {
