@@ -9,15 +9,6 @@
 
 namespace ecsim {
 
-void UniqueFd::reset(int fd) {
-  if (fd_ >= 0) ::close(fd_);
-  fd_ = fd;
-}
-
-std::string errnoText(int err) {
-  return std::string(std::strerror(err)) + " (errno " + std::to_string(err) + ")";
-}
-
 Result<bool> waitReadable(int fd, std::chrono::nanoseconds timeout) {
   const auto ns = timeout.count() > 0 ? timeout.count() : 0;
   timespec ts{};

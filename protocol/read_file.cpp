@@ -8,17 +8,10 @@
 #include <cerrno>
 #include <cstring>
 
+#include "protocol/unique_fd.hpp"
+
 namespace ecsim {
 namespace {
-
-std::string fileKind(mode_t mode) {
-  if (S_ISDIR(mode)) return "a directory";
-  if (S_ISFIFO(mode)) return "a FIFO";
-  if (S_ISCHR(mode)) return "a character device";
-  if (S_ISBLK(mode)) return "a block device";
-  if (S_ISSOCK(mode)) return "a socket";
-  return "not a regular file";
-}
 
 std::string sizeText(std::size_t bytes) {
   if (bytes % (std::size_t{1} << 20) == 0) return std::to_string(bytes >> 20) + " MiB";
@@ -34,23 +27,17 @@ Error osFailure(const std::filesystem::path& path, const char* call, int err) {
                  std::string(call) + ": " + std::strerror(err));
 }
 
-// Closes the descriptor on every return path.
-struct FdCloser {
-  int fd;
-  ~FdCloser() { ::close(fd); }
-};
-
 }  // namespace
 
 Result<std::string> readRegularFile(const std::filesystem::path& path, std::size_t maxBytes) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
-  if (fd < 0) return osFailure(path, "cannot open", errno);
-  const FdCloser closer{fd};
+  const UniqueFd file(::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY));
+  if (!file.valid()) return osFailure(path, "cannot open", errno);
+  const int fd = file.get();
   struct stat st {};
   if (::fstat(fd, &st) != 0) return osFailure(path, "cannot stat", errno);
   if (!S_ISREG(st.st_mode)) {
     return failure(ErrorCode::kInvalidArgument, path,
-                   "is " + fileKind(st.st_mode) + ", not a regular file");
+                   std::string("is ") + fileKindText(st.st_mode) + ", not a regular file");
   }
   const auto size = static_cast<std::size_t>(st.st_size);
   const std::string limit = "; the limit is " + sizeText(maxBytes);

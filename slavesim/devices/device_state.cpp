@@ -10,8 +10,9 @@
 #include <cmath>
 #include <cstdio>
 #include <string_view>
-#include <system_error>
 #include <utility>
+
+#include "protocol/unique_fd.hpp"
 
 namespace ecsim::slavesim::devices {
 namespace {
@@ -22,8 +23,6 @@ constexpr std::string_view kShaftAngle = "shaft-angle-rad";
 
 using Buffer = std::array<char, kMaxDeviceStateBytes + 1>;
 
-std::string osText(int err) { return std::system_category().message(err); }
-
 Error refused(const std::filesystem::path& path, const std::string& why) {
   return makeError(ErrorCode::kInvalidArgument,
                    path.string() + ": " + why + ": refused as a device state file, left as it is");
@@ -33,30 +32,6 @@ Error parseError(const std::filesystem::path& path, int line, const std::string&
   return makeError(ErrorCode::kParse, path.string() + ":" + std::to_string(line) + ": " + what);
 }
 
-const char* kindOf(mode_t mode) {
-  if (S_ISDIR(mode)) return "a folder";
-  if (S_ISCHR(mode)) return "a character device";
-  if (S_ISBLK(mode)) return "a block device";
-  if (S_ISFIFO(mode)) return "a FIFO";
-  if (S_ISSOCK(mode)) return "a socket";
-  return "not a regular file";
-}
-
-class Fd {  // closes on every return
- public:
-  explicit Fd(int fd) : fd_(fd) {}
-  Fd(const Fd&) = delete;
-  Fd& operator=(const Fd&) = delete;
-  ~Fd() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  int get() const { return fd_; }
-  int release() { return std::exchange(fd_, -1); }
-
- private:
-  int fd_;
-};
-
 // Reads what `path` names into `buffer` without following a link or blocking: nullopt when
 // there is nothing, the number of bytes when it is a regular file of at most
 // kMaxDeviceStateBytes, an error naming the path otherwise.
@@ -65,14 +40,14 @@ Result<std::optional<std::size_t>> readExisting(const std::filesystem::path& pat
   struct stat st {};
   if (::lstat(path.c_str(), &st) != 0) {
     if (errno == ENOENT) return std::optional<std::size_t>();
-    return makeError(ErrorCode::kIo, path.string() + ": " + osText(errno));
+    return makeError(ErrorCode::kIo, path.string() + ": " + errnoText(errno));
   }
   if (S_ISLNK(st.st_mode)) {
     return refused(path, "a symbolic link (name the state file itself)");
   }
-  if (!S_ISREG(st.st_mode)) return refused(path, kindOf(st.st_mode));
-  Fd fd(::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC));
-  if (fd.get() < 0) return makeError(ErrorCode::kIo, path.string() + ": " + osText(errno));
+  if (!S_ISREG(st.st_mode)) return refused(path, fileKindText(st.st_mode));
+  UniqueFd fd(::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC));
+  if (fd.get() < 0) return makeError(ErrorCode::kIo, path.string() + ": " + errnoText(errno));
   if (::fstat(fd.get(), &st) != 0 || !S_ISREG(st.st_mode)) {  // replaced since the lstat
     return refused(path, "not a regular file");
   }
@@ -80,7 +55,7 @@ Result<std::optional<std::size_t>> readExisting(const std::filesystem::path& pat
   while (size < buffer.size()) {
     const ssize_t n = ::read(fd.get(), buffer.data() + size, buffer.size() - size);
     if (n < 0 && errno == EINTR) continue;
-    if (n < 0) return makeError(ErrorCode::kIo, path.string() + ": " + osText(errno));
+    if (n < 0) return makeError(ErrorCode::kIo, path.string() + ": " + errnoText(errno));
     if (n == 0) break;
     size += static_cast<std::size_t>(n);
   }
@@ -138,12 +113,12 @@ Result<int> createTemporary(const std::string& tmp) {
   for (int attempt = 0; attempt < 2; ++attempt) {
     const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
     if (fd >= 0) return fd;
-    if (errno != EEXIST) return makeError(ErrorCode::kIo, tmp + ": " + osText(errno));
+    if (errno != EEXIST) return makeError(ErrorCode::kIo, tmp + ": " + errnoText(errno));
     struct stat st {};
     if (::lstat(tmp.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) {
       return refused(tmp, "there and not a regular file");
     }
-    if (::unlink(tmp.c_str()) != 0) return makeError(ErrorCode::kIo, tmp + ": " + osText(errno));
+    if (::unlink(tmp.c_str()) != 0) return makeError(ErrorCode::kIo, tmp + ": " + errnoText(errno));
   }
   return makeError(ErrorCode::kIo, tmp + ": keeps coming back");
 }
@@ -152,7 +127,7 @@ Status writeAll(int fd, const char* data, std::size_t size, const std::string& s
   while (size > 0) {
     const ssize_t n = ::write(fd, data, size);
     if (n < 0 && errno == EINTR) continue;
-    if (n < 0) return makeError(ErrorCode::kIo, shown + ": write failed: " + osText(errno));
+    if (n < 0) return makeError(ErrorCode::kIo, shown + ": write failed: " + errnoText(errno));
     data += n;
     size -= static_cast<std::size_t>(n);
   }
@@ -198,25 +173,25 @@ Status DeviceStateFile::save(const DeviceState& state) const {
   }
   {
     ECSIM_ASSIGN_OR_RETURN(int raw, createTemporary(tmp_));
-    Fd fd(raw);
+    UniqueFd fd(raw);
     ECSIM_TRY(writeAll(fd.get(), buffer.data(), static_cast<std::size_t>(length), tmp_));
     if (::fsync(fd.get()) != 0) {
-      return makeError(ErrorCode::kIo, tmp_ + ": fsync failed: " + osText(errno));
+      return makeError(ErrorCode::kIo, tmp_ + ": fsync failed: " + errnoText(errno));
     }
     if (::close(fd.release()) != 0) {
-      return makeError(ErrorCode::kIo, tmp_ + ": close failed: " + osText(errno));
+      return makeError(ErrorCode::kIo, tmp_ + ": close failed: " + errnoText(errno));
     }
   }
   if (::rename(tmp_.c_str(), path_.c_str()) != 0) {
     const int err = errno;
     ::unlink(tmp_.c_str());
     return makeError(ErrorCode::kIo,
-                     path_.string() + ": cannot replace device state: " + osText(err));
+                     path_.string() + ": cannot replace device state: " + errnoText(err));
   }
   // The rename itself reaches the disk only with its folder.
-  Fd folder(::open(folder_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
+  UniqueFd folder(::open(folder_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
   if (folder.get() < 0 || ::fsync(folder.get()) != 0) {
-    return makeError(ErrorCode::kIo, folder_ + ": fsync of the folder failed: " + osText(errno));
+    return makeError(ErrorCode::kIo, folder_ + ": fsync of the folder failed: " + errnoText(errno));
   }
   return okStatus();
 }
