@@ -2,7 +2,12 @@
 // prints, its JSON.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "link/netns.hpp"
 
@@ -127,6 +132,28 @@ TEST(EcmasterTool, IdentityCheckAgainstAConfigFile) {
   EXPECT_NE(out.output.find("slave 1 (0x1002 'Slave2') configured as 'S2'"), std::string::npos)
       << out.output;
   EXPECT_NE(out.output.find("product code 0x00010001 (expected 0x00099999)"), std::string::npos)
+      << out.output;
+}
+
+// An ENI is a vendor format: a value its reader ignores is a warning on stderr with file and
+// line, not lost silently (issue #21). The demo ENI with its cyclic CycleTime made 0 us.
+TEST(EcmasterTool, EniValuesIgnoredAreWarnedAbout) {
+  std::ifstream in(std::string(ECSIM_SOURCE_DIR) + "/examples/eni/demo-eni.xml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string eni = text.str();
+  const std::string cycle = "<CycleTime>1000</CycleTime>";
+  const auto at = eni.find(cycle);
+  ASSERT_NE(at, std::string::npos);
+  eni.replace(at, cycle.size(), "<CycleTime>0</CycleTime>");
+  const std::string path = ::testing::TempDir() + "ecmaster_odd_eni_" +
+                           std::to_string(::getpid()) + ".xml";
+  std::ofstream(path) << eni;
+  auto out = run({"--sim", kDemo, "--config", path, "slaves"});
+  std::remove(path.c_str());
+  EXPECT_EQ(out.exitCode, 0) << out.output;
+  EXPECT_NE(out.output.find("ecmaster: warning: "), std::string::npos) << out.output;
+  EXPECT_NE(out.output.find("CycleTime 0 us is outside [1, 1000000]"), std::string::npos)
       << out.output;
 }
 

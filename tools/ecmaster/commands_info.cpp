@@ -33,7 +33,13 @@ Result<std::unique_ptr<Connection>> connectAndScan(const GlobalOptions& global, 
   options.recovery = recovery;
   options.transport.timeout = static_cast<SimTime>(global.timeoutMs) * kNsPerMs;
   ECSIM_ASSIGN_OR_RETURN(auto connection, Connection::open(global.connect, options));
-  if (!global.config.empty()) ECSIM_TRY(connection->master().loadConfig(global.config));
+  if (!global.config.empty()) {
+    ECSIM_TRY(connection->master().loadConfig(global.config));
+    // An ENI is a vendor format: what its reader ignored is said, not lost (issue #21).
+    if (const auto& eni = connection->master().config()->eni) {
+      for (const auto& w : eni->warnings) fmt::print(stderr, "ecmaster: warning: {}\n", w);
+    }
+  }
   ECSIM_TRY(connection->master().scan());
   if (const auto& config = connection->master().config()) {
     ECSIM_TRY(master::checkIdentities(*config, connection->master().slaves()));
