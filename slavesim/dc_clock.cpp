@@ -80,4 +80,13 @@ std::int64_t DcClock::onSystemTimeWrite(SimTime global, SimTime localSystemTime,
   return diff;
 }
 
+std::uint32_t systemTimeDifferenceRegister(std::int64_t diff) {
+  constexpr std::int64_t kMaxMagnitude = 0x7FFFFFFF;
+  constexpr std::uint32_t kLocalSmaller = 0x80000000u;
+  // Clamped before the sign is taken off: -INT64_MIN does not exist.
+  const std::int64_t held = std::clamp(diff, -kMaxMagnitude, kMaxMagnitude);
+  const auto magnitude = static_cast<std::uint32_t>(held < 0 ? -held : held);
+  return diff < 0 ? (magnitude | kLocalSmaller) : magnitude;
+}
+
 }  // namespace ecsim::slavesim

@@ -50,4 +50,10 @@ class DcClock {
   bool haveLastWrite_{false};
 };
 
+// The system time difference register 0x092C for a difference `diff` (local copy minus
+// received time): bit 31 set when the local copy is smaller, bits 30-0 the magnitude, held at
+// 0x7FFFFFFF beyond it (datasheet section II, 0x092C). Any 64-bit difference, INT64_MIN
+// included: a master may write any time.
+std::uint32_t systemTimeDifferenceRegister(std::int64_t diff);
+
 }  // namespace ecsim::slavesim

@@ -537,9 +537,7 @@ void Esc::systemTimeWritten(std::uint32_t begin, std::uint32_t end, ConstBytes d
       wrapAdd(static_cast<SimTime>(written), reg32(reg::kSystemTimeDelay.address));
   const std::int64_t diff = dc_.onSystemTimeWrite(
       now_, local, received, memory_[reg::kSystemTimeDifferenceFilterDepth.address] & 0x0F);
-  const std::uint32_t mag =
-      static_cast<std::uint32_t>(std::min<std::int64_t>(diff < 0 ? -diff : diff, 0x7FFFFFFF));
-  writeLe32(memory_, reg::kSystemTimeDifference.address, diff < 0 ? (mag | 0x80000000u) : mag);
+  writeLe32(memory_, reg::kSystemTimeDifference.address, systemTimeDifferenceRegister(diff));
 }
 
 bool Esc::writeRegisters(std::uint16_t address, ConstBytes data) {

@@ -6,7 +6,10 @@
 // 0x002C.
 #include <gtest/gtest.h>
 
+#include <cstdint>
+
 #include "protocol/sii.hpp"
+#include "slavesim/dc_clock.hpp"
 #include "support/test_network.hpp"
 
 namespace ecsim::testing {
@@ -326,6 +329,21 @@ TEST_F(TimeUnits, LosingSync0InOpGivesFatalSyncError) {
   wr(0x0981, {0x00}, 5 * kMs);
   EXPECT_EQ(status(5 * kMs), 0x0014);
   EXPECT_EQ(code(5 * kMs), 0x002C);
+}
+
+// 0x092C (datasheet section II): bit 31 "local copy smaller", bits 30-0 the magnitude, held
+// at its largest. A master may write any system time, so any 64-bit difference arrives here:
+// fuzz_esc found INT64_MIN, whose negation overflowed (UBSan abort).
+TEST(SystemTimeDifference, EveryDifferenceHasARegisterValue) {
+  using slavesim::systemTimeDifferenceRegister;
+  EXPECT_EQ(systemTimeDifferenceRegister(0), 0u);
+  EXPECT_EQ(systemTimeDifferenceRegister(5), 5u);
+  EXPECT_EQ(systemTimeDifferenceRegister(-5), 0x80000005u);
+  EXPECT_EQ(systemTimeDifferenceRegister(0x7FFFFFFF), 0x7FFFFFFFu);
+  EXPECT_EQ(systemTimeDifferenceRegister(0x80000000), 0x7FFFFFFFu);
+  EXPECT_EQ(systemTimeDifferenceRegister(-0x80000000LL), 0xFFFFFFFFu);
+  EXPECT_EQ(systemTimeDifferenceRegister(INT64_MAX), 0x7FFFFFFFu);
+  EXPECT_EQ(systemTimeDifferenceRegister(INT64_MIN), 0xFFFFFFFFu);
 }
 
 }  // namespace
