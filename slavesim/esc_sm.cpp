@@ -1,0 +1,265 @@
+// SyncManagers (datasheet section I §8): ECAT access to mailbox and 3-buffer areas and the PDI
+// side the firmware uses (mailbox receive/send/repeat, process data buffers).
+#include "slavesim/esc.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+#include "slavesim/esc_internal.hpp"
+
+namespace ecsim::slavesim {
+using namespace esc_detail;
+int Esc::smLookup(std::uint32_t at, std::uint32_t& limit) const {
+  for (std::uint8_t k = 0; k < smRangeCount_; ++k) {
+    const SmRange& r = smRanges_[k];
+    if (at >= r.start && at < r.end) {
+      limit = std::min(limit, r.end);
+      return r.index;
+    }
+    if (r.start > at) limit = std::min<std::uint32_t>(limit, r.start);
+  }
+  return -1;
+}
+
+void Esc::rebuildSmCache() {
+  smRangeCount_ = 0;
+  for (unsigned s = 0; s < type_.syncManagers; ++s) {
+    const SmConfig c = smConfig(s);
+    if (!c.enabled || c.length == 0) continue;
+    smRanges_[smRangeCount_++] = {c.start, static_cast<std::uint32_t>(c.start) + c.length,
+                                  static_cast<std::uint8_t>(s)};
+    smCache_[s] = c;
+  }
+}
+
+Esc::SmConfig Esc::smConfig(unsigned s) const {
+  std::uint16_t base = reg::smChannel(s);
+  SmConfig c;
+  c.start = readLe16(memory_, base + reg::sm::kPhysicalStart.address);
+  c.length = readLe16(memory_, base + reg::sm::kLength.address);
+  c.control = memory_[base + reg::sm::kControl.address];
+  // An SM that does not exist on this ESC, or whose area runs past the ESC's memory, never
+  // works: treated as disabled (so no buffer logic can reach outside the memory).
+  c.enabled = s < type_.syncManagers &&
+              (memory_[base + reg::sm::kActivate.address] & reg::sm::kActivateEnable) != 0 &&
+              (memory_[base + reg::sm::kPdiControl.address] & reg::sm::kPdiDeactivate) == 0 &&
+              static_cast<std::size_t>(c.start) + c.length <= memory_.size();
+  return c;
+}
+
+bool Esc::readRam(std::uint16_t address, Bytes out, bool orInto, int smIndex) {
+  auto copyOut = [&](const std::uint8_t* src) {
+    if (!orInto) {
+      std::copy_n(src, out.size(), out.begin());
+      return;
+    }
+    for (std::size_t i = 0; i < out.size(); ++i)
+      out[i] = static_cast<std::uint8_t>(out[i] | src[i]);
+  };
+  if (smIndex < 0) {
+    copyOut(&memory_[address]);
+    return true;
+  }
+  const auto s = static_cast<unsigned>(smIndex);
+  const SmConfig& cfg = smCache_[s];  // smIndex comes from smLookup: the SM is cached
+  SmState& st = sm_[s];
+  const std::uint16_t base = reg::smChannel(s);
+  const bool lastByte = address + out.size() == static_cast<std::size_t>(cfg.start) + cfg.length;
+  if (isMailbox(cfg.control)) {
+    if (isEcatWrite(cfg.control) || !st.mailboxFull) return false;  // nothing to read
+    copyOut(&memory_[address]);
+    if (lastByte) {  // reading the last byte empties the mailbox
+      st.mailboxFull = false;
+      memory_[base + reg::sm::kStatus.address] &=
+          static_cast<std::uint8_t>(~reg::sm::kStatusMailboxFull);
+      events_.mailboxRead = true;
+    }
+    return true;
+  }
+  // 3-buffer mode: the master reads the newest complete buffer the PDI wrote.
+  const std::size_t offset = static_cast<std::size_t>(address - cfg.start);
+  const std::size_t bufBase = 3u * static_cast<std::size_t>(cfg.start);
+  if (isEcatWrite(cfg.control)) {
+    // Reading back an output SM gives the newest complete buffer as well.
+    copyOut(&buffers_[bufBase + st.latest * cfg.length + offset]);
+    return true;
+  }
+  copyOut(&buffers_[bufBase + st.latest * cfg.length + offset]);
+  return true;
+}
+
+bool Esc::writeRam(std::uint16_t address, ConstBytes data, int smIndex) {
+  if (smIndex < 0) {
+    std::copy(data.begin(), data.end(), memory_.begin() + address);
+    return true;
+  }
+  const auto s = static_cast<unsigned>(smIndex);
+  const SmConfig& cfg = smCache_[s];  // smIndex comes from smLookup: the SM is cached
+  SmState& st = sm_[s];
+  const std::uint16_t base = reg::smChannel(s);
+  const bool lastByte = address + data.size() == static_cast<std::size_t>(cfg.start) + cfg.length;
+  if (isMailbox(cfg.control)) {
+    if (!isEcatWrite(cfg.control)) return false;  // master may not write a read mailbox
+    if (st.mailboxFull) {
+      ++counters_.mailboxWritesRejected;
+      return false;  // full: write refused, no WKC (the master retries)
+    }
+    std::copy(data.begin(), data.end(), memory_.begin() + address);
+    if ((cfg.control & reg::sm::kControlWatchdog) != 0) triggerPdWatchdog();
+    if (lastByte) {
+      st.mailboxFull = true;
+      st.hasLatest = true;  // for 1-buffer process data: outputs received
+      memory_[base + reg::sm::kStatus.address] |= reg::sm::kStatusMailboxFull;
+      ++counters_.mailboxWrites;
+      events_.mailboxReceived = true;
+    }
+    return true;
+  }
+  if (!isEcatWrite(cfg.control)) return false;  // inputs: master writes are ignored
+  if ((cfg.control & reg::sm::kControlWatchdog) != 0) triggerPdWatchdog();
+  const std::size_t offset = static_cast<std::size_t>(address - cfg.start);
+  const std::size_t bufBase = 3u * static_cast<std::size_t>(cfg.start);
+  std::copy(
+      data.begin(), data.end(),
+      buffers_.begin() + static_cast<std::ptrdiff_t>(bufBase + st.writing * cfg.length + offset));
+  if (lastByte) {  // buffer complete: it becomes the newest, writing continues in a free one
+    std::uint8_t done = st.writing;
+    std::uint8_t next = 0;
+    while (next == done || next == st.latest) ++next;
+    // Carry the complete buffer forward so a partial next write keeps unwritten bytes.
+    std::copy_n(buffers_.begin() + static_cast<std::ptrdiff_t>(bufBase + done * cfg.length),
+                cfg.length,
+                buffers_.begin() + static_cast<std::ptrdiff_t>(bufBase + next * cfg.length));
+    st.latest = done;
+    st.writing = next;
+    st.hasLatest = true;
+    memory_[base + reg::sm::kStatus.address] = static_cast<std::uint8_t>(
+        (memory_[base + reg::sm::kStatus.address] & ~reg::sm::kStatusBufferMask) | (done << 4) |
+        reg::sm::kStatusInterruptWrite);
+    events_.outputsWritten = true;
+  }
+  return true;
+}
+
+// ---- PDI side -------------------------------------------------------------------------------
+
+void Esc::pdiSetAlStatus(std::uint16_t status, std::uint16_t code) {
+  writeLe16(memory_, reg::kAlStatus.address, status);
+  writeLe16(memory_, reg::kAlStatusCode.address, code);
+}
+
+namespace {
+int findMailboxSm(const Esc& esc, unsigned count, bool ecatWrite) {
+  for (unsigned s = 0; s < count; ++s) {
+    auto c = esc.smConfig(s);
+    if (c.enabled && c.length > 0 && isMailbox(c.control) && isEcatWrite(c.control) == ecatWrite) {
+      return static_cast<int>(s);
+    }
+  }
+  return -1;
+}
+}  // namespace
+
+bool Esc::pdiMailboxAvailable() const {
+  return findMailboxSm(*this, type_.syncManagers, true) >= 0 &&
+         findMailboxSm(*this, type_.syncManagers, false) >= 0;
+}
+
+std::size_t Esc::pdiMailboxReceive(Bytes out) {
+  int s = findMailboxSm(*this, type_.syncManagers, true);
+  if (s < 0 || !sm_[static_cast<unsigned>(s)].mailboxFull) return 0;
+  auto c = smConfig(static_cast<unsigned>(s));
+  std::size_t n = std::min<std::size_t>(out.size(), c.length);
+  std::copy_n(memory_.begin() + c.start, n, out.begin());
+  sm_[static_cast<unsigned>(s)].mailboxFull = false;
+  memory_[reg::smChannel(static_cast<unsigned>(s)) + reg::sm::kStatus.address] &=
+      static_cast<std::uint8_t>(~reg::sm::kStatusMailboxFull);
+  return n;
+}
+
+bool Esc::pdiMailboxSend(ConstBytes data) {
+  int s = findMailboxSm(*this, type_.syncManagers, false);
+  if (s < 0) return false;
+  auto& st = sm_[static_cast<unsigned>(s)];
+  if (st.mailboxFull) return false;
+  auto c = smConfig(static_cast<unsigned>(s));
+  std::size_t n = std::min<std::size_t>(data.size(), c.length);
+  std::copy_n(data.begin(), n, memory_.begin() + c.start);
+  std::fill_n(memory_.begin() + c.start + static_cast<std::ptrdiff_t>(n), c.length - n, 0);
+  std::copy_n(memory_.begin() + c.start, c.length, lastMailboxResponse_.begin());
+  lastMailboxResponseSize_ = c.length;
+  st.mailboxFull = true;
+  memory_[reg::smChannel(static_cast<unsigned>(s)) + reg::sm::kStatus.address] |=
+      reg::sm::kStatusMailboxFull;
+  return true;
+}
+
+bool Esc::pdiMailboxResponsePending() const {
+  int s = findMailboxSm(*this, type_.syncManagers, false);
+  return s >= 0 && sm_[static_cast<unsigned>(s)].mailboxFull;
+}
+
+void Esc::pdiMailboxRepeat() {
+  int s = findMailboxSm(*this, type_.syncManagers, false);
+  if (s < 0) return;
+  const auto su = static_cast<unsigned>(s);
+  const std::uint16_t base = reg::smChannel(su);
+  auto c = smConfig(su);
+  if (lastMailboxResponseSize_ > 0 && lastMailboxResponseSize_ <= c.length) {
+    std::copy_n(lastMailboxResponse_.begin(), lastMailboxResponseSize_, memory_.begin() + c.start);
+    sm_[su].mailboxFull = true;
+    memory_[base + reg::sm::kStatus.address] |= reg::sm::kStatusMailboxFull;
+  }
+  // Acknowledge: copy the repeat request bit into the PDI control repeat-ack bit.
+  std::uint8_t req = memory_[base + reg::sm::kActivate.address] & reg::sm::kActivateRepeatRequest;
+  memory_[base + reg::sm::kPdiControl.address] = static_cast<std::uint8_t>(
+      (memory_[base + reg::sm::kPdiControl.address] & ~reg::sm::kPdiRepeatAck) | req);
+}
+
+ConstBytes Esc::pdiOutputs(unsigned s) const {
+  if (s >= type_.syncManagers) return {};
+  auto c = smConfig(s);
+  if (!c.enabled || !isEcatWrite(c.control) || c.length == 0) return {};
+  // 1-buffer (mailbox-mode) process data: the buffer is the memory itself.
+  if (isMailbox(c.control)) return ConstBytes(memory_.data() + c.start, c.length);
+  const std::size_t bufBase = 3u * static_cast<std::size_t>(c.start);
+  return ConstBytes(buffers_.data() + bufBase + sm_[s].latest * c.length, c.length);
+}
+
+bool Esc::pdiWriteInputs(unsigned s, ConstBytes data) {
+  if (s >= type_.syncManagers) return false;
+  auto c = smConfig(s);
+  if (!c.enabled || isEcatWrite(c.control) || c.length == 0) return false;
+  auto& st = sm_[s];
+  if (isMailbox(c.control)) {
+    // 1-buffer inputs: the PDI may write only when the master has read the last buffer.
+    if (st.mailboxFull) return false;
+    const std::size_t n1 = std::min<std::size_t>(data.size(), c.length);
+    std::copy_n(data.begin(), n1, memory_.begin() + c.start);
+    st.mailboxFull = true;
+    memory_[reg::smChannel(s) + reg::sm::kStatus.address] |= reg::sm::kStatusMailboxFull;
+    return true;
+  }
+  const std::size_t bufBase = 3u * static_cast<std::size_t>(c.start);
+  std::size_t n = std::min<std::size_t>(data.size(), c.length);
+  std::copy_n(data.begin(), n,
+              buffers_.begin() + static_cast<std::ptrdiff_t>(bufBase + st.writing * c.length));
+  std::uint8_t done = st.writing;
+  std::uint8_t next = 0;
+  while (next == done || next == st.latest) ++next;
+  st.latest = done;
+  st.writing = next;
+  st.hasLatest = true;
+  return true;
+}
+
+void Esc::pdiReleaseBuffer(unsigned s) {
+  if (s >= type_.syncManagers) return;
+  auto c = smConfig(s);
+  if (!c.enabled || !isMailbox(c.control) || !isEcatWrite(c.control)) return;
+  sm_[s].mailboxFull = false;
+  memory_[reg::smChannel(s) + reg::sm::kStatus.address] &=
+      static_cast<std::uint8_t>(~reg::sm::kStatusMailboxFull);
+}
+
+}  // namespace ecsim::slavesim
