@@ -145,6 +145,24 @@ class Esc {
     return e;
   }
 
+  // Typed register access through the register map (protocol/registers.hpp): the width comes
+  // from the register, never from the caller. Little-endian as on the wire.
+  template <typename T>
+  T read(reg::Reg<T> r) const {
+    std::uint64_t v = 0;
+    for (unsigned i = 0; i < sizeof(T); ++i)
+      v |= static_cast<std::uint64_t>(memory_[r.address + i]) << (8 * i);
+    return static_cast<T>(v);
+  }
+  // PDI-side write of a whole register (no ECAT write masks; FMMU/SM caches follow).
+  template <typename T>
+  void pdiWrite(reg::Reg<T> r, T value) {
+    const auto v = static_cast<std::uint64_t>(value);
+    for (unsigned i = 0; i < sizeof(T); ++i)
+      memory_[r.address + i] = static_cast<std::uint8_t>(v >> (8 * i));
+    afterPdiWrite(r.address);
+  }
+
   // Raw register access for tests, the status view and fault injection.
   std::uint8_t reg8(std::uint16_t address) const { return memory_[address]; }
   std::uint16_t reg16(std::uint16_t address) const { return readLe16(memory_, address); }
