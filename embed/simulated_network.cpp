@@ -20,7 +20,7 @@ std::string slaveLabel(const slavesim::Slave& slave, std::size_t position) {
 // ---- SimulatedSlave --------------------------------------------------------------------------
 
 std::uint16_t SimulatedSlave::alStatusCode() const {
-  return slave_->esc().reg16(reg::kAlStatusCode.address);
+  return slave_->esc().read(reg::kAlStatusCode);
 }
 
 Result<std::vector<std::uint8_t>> SimulatedSlave::readRegisters(std::uint16_t address,

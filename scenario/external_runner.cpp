@@ -239,7 +239,7 @@ ExpectationResult ExternalRun::evaluatePoint(const Expectation& x, SimTime at) c
   const auto& esc = network_.segment->slave(*slave).esc();
   if (x.kind == ExpectKind::kState) {
     const std::uint16_t status = esc.alStatus();
-    const std::uint16_t code = esc.reg16(reg::kAlStatusCode.address);
+    const std::uint16_t code = esc.read(reg::kAlStatusCode);
     res.observed = stateText(status, code);
     auto state = alStateFromRaw(static_cast<std::uint16_t>(status & kAlStateMask));
     bool ok = state && toString(*state) == x.state;
@@ -282,7 +282,7 @@ ExpectationResult ExternalRun::evaluateBackInOp(std::size_t i, SimTime end) cons
   for (std::size_t k = 0; k < seg.size(); ++k) {
     const auto& esc = seg.slave(k).esc();
     states += fmt::format("{}{} {}", k == 0 ? "" : ", ", seg.slave(k).name(),
-                          stateText(esc.alStatus(), esc.reg16(reg::kAlStatusCode.address)));
+                          stateText(esc.alStatus(), esc.read(reg::kAlStatusCode)));
   }
   res.observed = "never back in OP after " + after + "; at the end: " + states;
   return res;

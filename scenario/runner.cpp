@@ -125,7 +125,7 @@ std::string Run::slaveNameAtPosition(std::size_t position) const {
 void Run::learnStations() {
   auto& seg = *network_.segment;
   for (std::size_t i = 0; i < seg.size(); ++i) {
-    const std::uint16_t station = seg.slave(i).esc().reg16(0x0010);
+    const std::uint16_t station = seg.slave(i).esc().read(reg::kConfiguredStationAddress);
     if (station != 0) stationNames_[station] = seg.slave(i).name();
   }
 }
@@ -208,7 +208,7 @@ ExpectationResult Run::evaluatePoint(const Expectation& x) {
     case ExpectKind::kState: {
       const auto& esc = seg.slave(*slave).esc();
       const std::uint16_t status = esc.alStatus();
-      const std::uint16_t code = esc.reg16(0x0134);
+      const std::uint16_t code = esc.read(reg::kAlStatusCode);
       res.observed = stateText(status, code);
       auto state = alStateFromRaw(static_cast<std::uint16_t>(status & kAlStateMask));
       bool ok = state && toString(*state) == x.state;
@@ -248,7 +248,7 @@ ExpectationResult Run::evaluatePoint(const Expectation& x) {
       break;
     }
     case ExpectKind::kVariable: {
-      const std::uint16_t station = seg.slave(*slave).esc().reg16(0x0010);
+      const std::uint16_t station = seg.slave(*slave).esc().read(reg::kConfiguredStationAddress);
       std::optional<std::size_t> position;
       for (const auto& info : master_->slaves()) {
         if (info.station == station) position = info.position;
@@ -355,7 +355,7 @@ void Run::evaluateWindows() {
         for (std::size_t k = 0; k < seg.size(); ++k) {
           const auto& esc = seg.slave(k).esc();
           states += fmt::format("{}{} {}", k == 0 ? "" : ", ", seg.slave(k).name(),
-                                stateText(esc.alStatus(), esc.reg16(0x0134)));
+                                stateText(esc.alStatus(), esc.read(reg::kAlStatusCode)));
         }
         res.observed = "never back in OP after cycle " + std::to_string(x.afterCycle) +
                        "; at the end: " + states;

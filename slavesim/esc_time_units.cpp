@@ -49,11 +49,11 @@ bool overlapsRange(std::uint16_t begin, std::uint16_t end, std::uint16_t address
 
 bool Esc::pdWatchdogExpired(SimTime now) {
   if (!pdWatchdog_.armed || pdWatchdog_.expired) return false;
-  const std::uint64_t ticks = reg16(reg::kWatchdogTimeProcessData.address);
+  const std::uint64_t ticks = read(reg::kWatchdogTimeProcessData);
   if (ticks == 0) return false;  // disabled
   // One watchdog increment is (divider + 2) periods of the 25 MHz clock (40 ns).
   const std::uint64_t unitNs =
-      (static_cast<std::uint64_t>(reg16(reg::kWatchdogDivider.address)) + 2) * 40;
+      (static_cast<std::uint64_t>(read(reg::kWatchdogDivider)) + 2) * 40;
   const auto timeout = static_cast<SimTime>(ticks * unitNs);
   if (now - pdWatchdog_.lastTrigger < timeout) return false;
   pdWatchdog_.expired = true;
@@ -66,7 +66,7 @@ bool Esc::pdWatchdogExpired(SimTime now) {
 // ---- cyclic unit ------------------------------------------------------------------------------
 
 std::uint64_t Esc::systemTimeNow() const {
-  return static_cast<std::uint64_t>(localNow_) + reg64(reg::kSystemTimeOffset.address);
+  return static_cast<std::uint64_t>(localNow_) + read(reg::kSystemTimeOffset);
 }
 
 void Esc::onSyncActivationWrite() {
@@ -88,10 +88,10 @@ void Esc::onSyncActivationWrite() {
   sync_.running = true;
   sync_.sync0 = (act & kActivationSync0) != 0;
   sync_.sync1 = (act & kActivationSync1) != 0;
-  sync_.start = reg64(reg::kStartTimeCyclicOperation.address);
-  sync_.cycle0 = reg32(reg::kSync0CycleTime.address);
-  sync_.cycle1 = reg32(reg::kSync1CycleTime.address);
-  sync_.pulseLength = static_cast<std::uint64_t>(reg16(reg::kSyncPulseLength.address)) * 10;
+  sync_.start = read(reg::kStartTimeCyclicOperation);
+  sync_.cycle0 = read(reg::kSync0CycleTime);
+  sync_.cycle1 = read(reg::kSync1CycleTime);
+  sync_.pulseLength = static_cast<std::uint64_t>(read(reg::kSyncPulseLength)) * 10;
   const std::uint64_t sysNow = systemTimeNow();
   sync_.startMissed = !notAfter(sysNow, sync_.start);
   sync_.ack0 = sync_.ack1 = sysNow;
@@ -129,7 +129,7 @@ std::uint64_t Esc::sync1IndexAfter(std::uint64_t sysNow) const {
 bool Esc::nextSyncPulse(SimTime now, SyncPulse& pulse) {
   if (!sync_.running || sync_.startMissed) return false;
   const std::uint64_t sysNow =
-      static_cast<std::uint64_t>(dc_.localTime(now)) + reg64(reg::kSystemTimeOffset.address);
+      static_cast<std::uint64_t>(dc_.localTime(now)) + read(reg::kSystemTimeOffset);
   bool have0 = sync_.sync0 && !sync_.done0;
   bool have1 = sync_.sync1 && !sync_.done1;
   const std::uint64_t t0 = sync_.start + sync_.next0Index * sync_.cycle0;
@@ -148,7 +148,7 @@ bool Esc::nextSyncPulse(SimTime now, SyncPulse& pulse) {
   }
   pulse.signal = take0 ? 0 : 1;
   // Local time of the pulse, then the simulation time at which the local clock shows it.
-  const auto local = static_cast<SimTime>(t - reg64(reg::kSystemTimeOffset.address));
+  const auto local = static_cast<SimTime>(t - read(reg::kSystemTimeOffset));
   pulse.time = dc_.globalTime(local);
   return true;
 }

@@ -13,7 +13,7 @@
 namespace ecsim::tools {
 namespace {
 
-constexpr std::uint16_t kAlStatusErrorFlag = 0x0010;
+constexpr std::uint16_t kAlStatusErrorFlag = reg::al::kErrorFlag;
 
 std::string jsonString(std::string_view text) {
   std::string out = "\"";
@@ -87,7 +87,7 @@ StatusSnapshot takeStatusSnapshot(topology::Segment& segment,
     s.name = slave.name();
     s.state = slave.state();
     s.alError = (esc.alStatus() & kAlStatusErrorFlag) != 0;
-    s.alStatusCode = esc.reg16(reg::kAlStatusCode.address);
+    s.alStatusCode = esc.read(reg::kAlStatusCode);
     s.frames = esc.counters().framesSeen;
     s.datagrams = esc.counters().datagramsAddressed;
     for (unsigned port = 0; port < topology::kPortCount; ++port) {
@@ -96,7 +96,7 @@ StatusSnapshot takeStatusSnapshot(topology::Segment& segment,
       s.rxErrors += esc.reg8(reg::forwardedRxErrorCounter(port));
       s.lostLinks += esc.reg8(reg::lostLinkCounter(port));
     }
-    s.dcDifferenceNs = decodeSystemTimeDifference(esc.reg32(reg::kSystemTimeDifference.address));
+    s.dcDifferenceNs = decodeSystemTimeDifference(esc.read(reg::kSystemTimeDifference));
     if (auto* device = slavesim::processDataDeviceOf(slave)) {
       const auto& od = device->dictionary();
       for (const auto& sm : device->binding().layout()) {
