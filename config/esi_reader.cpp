@@ -153,9 +153,20 @@ Result<EsiEeprom> readEeprom(const Context& ctx, const Element* e) {
 }
 
 Status readSlots(const Context& ctx, const Element* e, std::vector<EsiSlot>& out) {
+  if (e == nullptr) return okStatus();
+  ECSIM_ASSIGN_OR_RETURN(auto indexIncrement,
+                         xml::attrNumber<std::uint32_t>(ctx, e, "SlotIndexIncrement"));
+  ECSIM_ASSIGN_OR_RETURN(auto pdoIncrement,
+                         xml::attrNumber<std::uint32_t>(ctx, e, "SlotPdoIncrement"));
   for (const Element* s : Children(e, "Slot")) {
     EsiSlot slot;
+    slot.line = s->GetLineNum();
     slot.name = std::string(xml::childText(s, "Name"));
+    ECSIM_ASSIGN_OR_RETURN(auto ownIndex,
+                           xml::attrNumber<std::uint32_t>(ctx, s, "SlotIndexIncrement"));
+    ECSIM_ASSIGN_OR_RETURN(auto ownPdo, xml::attrNumber<std::uint32_t>(ctx, s, "SlotPdoIncrement"));
+    slot.indexIncrement = ownIndex.value_or(indexIncrement.value_or(0));
+    slot.pdoIncrement = ownPdo.value_or(pdoIncrement.value_or(0));
     ECSIM_ASSIGN_OR_RETURN(auto min, xml::attrNumber<std::uint32_t>(ctx, s, "MinInstances"));
     ECSIM_ASSIGN_OR_RETURN(auto max, xml::attrNumber<std::uint32_t>(ctx, s, "MaxInstances"));
     slot.minInstances = min.value_or(0);
@@ -167,6 +178,8 @@ Status readSlots(const Context& ctx, const Element* e, std::vector<EsiSlot>& out
       ECSIM_ASSIGN_OR_RETURN(auto ident,
                              xml::parseNumber<std::uint32_t>(ctx, m, "ModuleIdent", xml::text(m)));
       slot.moduleIdents.push_back(ident);
+      ECSIM_ASSIGN_OR_RETURN(const bool isDefault, xml::attrBool(ctx, m, "Default", false));
+      if (isDefault && !slot.defaultModuleIdent) slot.defaultModuleIdent = ident;
     }
     out.push_back(std::move(slot));
   }
@@ -368,10 +381,12 @@ Result<EsiModule> readModule(const Context& ctx, const Element* e) {
 }  // namespace esi_detail
 
 Result<EsiFile> parseEsi(std::string_view xmlText, std::string_view fileName) {
-  const Context ctx{std::string(fileName)};
+  std::vector<std::string> warnings;
+  const Context ctx{std::string(fileName), &warnings};
   tinyxml2::XMLDocument doc(true, tinyxml2::PRESERVE_WHITESPACE);
   ECSIM_TRY(xml::parseDocument(xmlText, ctx, doc));
   ECSIM_ASSIGN_OR_RETURN(EsiFile file, readDocument(ctx, doc));
+  file.warnings = std::move(warnings);
   file.encoding = xml::declaredEncoding(xmlText);
   return file;
 }
