@@ -85,6 +85,13 @@ struct EsiPdo {
 
   std::string name() const { return std::string(pickLocalText(names)); }
   std::uint32_t bitLength() const;
+  // A PDO the dictionary can hold as a mapping object: 0x1600-0x1BFF (RxPDOs 0x1600-0x17FF and
+  // TxPDOs 0x1A00-0x1BFF in ETG.1000.6, plus 0x1800-0x19FF, which EtherCAT leaves free and
+  // vendors use: Orbita2d.xml's TxPdo 0x1800, kept in its real SII image Orbita2d.bin). Others
+  // collide with communication objects (Beckhoff_EL1xxx_2011.xml's EL1262 TxPdo 0x1C00 would be
+  // 0x1C00, the SM types) and are left out of the dictionary and the SII PDO categories alike,
+  // so SII and CoE give a master the same SM sizes.
+  constexpr bool inCoeRange() const { return index >= 0x1600 && index <= 0x1BFF; }
 };
 
 struct EsiCoe {

@@ -334,6 +334,29 @@ TEST(EsiReader, MalformedValueInsideAnObjectIsAWarning) {
   EXPECT_NE(file->warnings[1].find("left out"), std::string::npos) << file->warnings[1];
 }
 
+// Issue #15 item 11: SMs that overlap in the ESI are a warning naming both; the device is read
+// as written. A 3-buffer SM takes 3 x its length (ESC datasheet section I, SyncManager
+// chapter); an SM of length 1 is no buffer and takes its one byte (Beckhoff_EM2xxx.xml's
+// 0x0F00/0x0F01 pair, see EsiCorpus: no warning there).
+TEST(EsiReader, OverlappingSyncManagersAreAWarning) {
+  const char* text =
+      "<EtherCATInfo><Descriptions><Devices><Device>\n"
+      "<Type ProductCode=\"#x1\">X</Type>\n"
+      "<Sm StartAddress=\"#x1100\" DefaultSize=\"8\" ControlByte=\"#x64\">Outputs</Sm>\n"
+      "<Sm StartAddress=\"#x1110\" DefaultSize=\"4\" ControlByte=\"#x20\">Inputs</Sm>\n"  // 3 x 4
+      "<Sm StartAddress=\"#x0F00\" DefaultSize=\"1\" ControlByte=\"#x44\">Outputs</Sm>\n"
+      "<Sm StartAddress=\"#x0F01\" DefaultSize=\"1\" ControlByte=\"#x44\">Outputs</Sm>\n"
+      "</Device></Devices></Descriptions></EtherCATInfo>";
+  auto file = parseEsi(text, "sm.xml");
+  ASSERT_TRUE(file.ok()) << file.error().message();
+  ASSERT_EQ(file->devices.at(0).syncManagers.size(), 4u) << "read as written";
+  ASSERT_EQ(file->warnings.size(), 1u);
+  EXPECT_NE(file->warnings[0].find("sm.xml, line 4: Sm 1 (0x1110-0x111B) overlaps Sm 0 (line 3, "
+                                   "0x1100-0x1117)"),
+            std::string::npos)
+      << file->warnings[0];
+}
+
 TEST(EsiReader, UnknownRootIsAnError) {
   auto file = parseEsi("<EtherCATConfig/>", "eni.xml");
   ASSERT_FALSE(file.ok());
