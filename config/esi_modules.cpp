@@ -1,6 +1,8 @@
 // Modules in the slots of a modular device (see esi_modules.hpp).
 #include "config/esi_modules.hpp"
 
+#include <fmt/core.h>
+
 #include <algorithm>
 #include <map>
 #include <set>
@@ -11,11 +13,9 @@
 namespace ecsim {
 namespace {
 
+// A module ident as ESI files write it: #x00091F84.
 std::string hex8(std::uint32_t v) {
-  constexpr char kDigits[] = "0123456789ABCDEF";
-  std::string s = "#x";
-  for (int shift = 28; shift >= 0; shift -= 4) s += kDigits[(v >> shift) & 0xF];
-  return s;
+  return fmt::format("#x{:08X}", v);
 }
 
 bool isMappingIndex(std::uint32_t index) {
