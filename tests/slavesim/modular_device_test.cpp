@@ -94,5 +94,23 @@ TEST(ModularDevice, Ur20WithModulesReachesOpAndExchangesProcessData) {
   ASSERT_TRUE(m.stop().ok());
 }
 
+// A module type no ESI file has is an error with its line and the closest module type.
+TEST(ModularDevice, UnknownModuleTypeNamesTheClosest) {
+  if (!fs::exists(sharedEsi() / "Weidmueller_UR20_FBC.xml")) GTEST_SKIP() << "no " << sharedEsi();
+  TopologySlave entry;
+  entry.name = "Station";
+  entry.esiFile = sharedEsi() / "Weidmueller_UR20_FBC.xml";
+  entry.productCode = 0x4F911C30;
+  entry.moduleFile = sharedEsi() / "Weidmueller_UR20_IO.xml";
+  entry.modules.push_back({"UR20-4DI-PP", std::nullopt, 7});
+  topology::SlaveFactory factory;
+  auto slave = factory.make(entry);
+  ASSERT_FALSE(slave.ok());
+  EXPECT_NE(slave.error().context.find("line 7: unknown module type 'UR20-4DI-PP'; did you mean "
+                                       "'UR20-4DI-P'?"),
+            std::string::npos)
+      << slave.error().context;
+}
+
 }  // namespace
 }  // namespace ecsim::testing
