@@ -85,6 +85,13 @@ struct EsiPdo {
 
   std::string name() const { return std::string(pickLocalText(names)); }
   std::uint32_t bitLength() const;
+  // A PDO the dictionary can hold as a mapping object: 0x1600-0x1BFF (RxPDOs 0x1600-0x17FF and
+  // TxPDOs 0x1A00-0x1BFF in ETG.1000.6, plus 0x1800-0x19FF, which EtherCAT leaves free and
+  // vendors use: Orbita2d.xml's TxPdo 0x1800, kept in its real SII image Orbita2d.bin). Others
+  // collide with communication objects (Beckhoff_EL1xxx_2011.xml's EL1262 TxPdo 0x1C00 would be
+  // 0x1C00, the SM types) and are left out of the dictionary and the SII PDO categories alike,
+  // so SII and CoE give a master the same SM sizes.
+  constexpr bool inCoeRange() const { return index >= 0x1600 && index <= 0x1BFF; }
 };
 
 struct EsiCoe {
@@ -197,6 +204,7 @@ struct EsiObject {
   EsiValueInfo info;
   std::vector<EsiSubItemInfo> subItems;
   EsiFlags flags;
+  bool dependOnSlot{false};  // <Index DependOnSlot="1">: a module's object, moved per slot
   int line{0};
   std::string name() const { return std::string(pickLocalText(names)); }
 };
@@ -208,12 +216,19 @@ struct EsiDictionary {
   const EsiDataType* findDataType(std::string_view name) const;
 };
 
+// A <Slot> of a modular device (ETG.2001): which modules it takes, and how the objects and
+// PDOs of the module in slot instance k (counted from 0 over the device's slots) move:
+// index + k * indexIncrement (objects, PDO entries), + k * pdoIncrement (PDOs, mapping objects).
 struct EsiSlot {
   std::string name;
   std::uint32_t minInstances{0};
   std::uint32_t maxInstances{0};
   std::vector<std::string> moduleClasses;
   std::vector<std::uint32_t> moduleIdents;
+  std::optional<std::uint32_t> defaultModuleIdent;  // <ModuleIdent Default="1">
+  std::uint32_t indexIncrement{0};  // Slot@SlotIndexIncrement, else Slots@SlotIndexIncrement
+  std::uint32_t pdoIncrement{0};    // Slot@SlotPdoIncrement, else Slots@SlotPdoIncrement
+  int line{0};
 };
 
 struct EsiModule {
@@ -251,6 +266,9 @@ struct EsiDevice {
   EsiDictionary dictionary;
   std::vector<EsiSlot> slots;
   std::vector<EsiModule> modules;
+  // Module idents of the modules instantiated into this description (config/esi_modules.hpp),
+  // in slot order: the configured and detected module lists 0xF030/0xF050 (ETG.5001).
+  std::vector<std::uint32_t> moduleIdents;
   int line{0};
 
   std::string name(std::uint32_t lcid = 1033) const {
@@ -270,6 +288,9 @@ struct EsiFile {
   std::vector<EsiDevice> devices;
   std::vector<EsiModule> modules;  // EtherCATModule root
   EsiDictionary dictionary;        // EtherCATDict root
+  // What the reader replaced or left out to go on ("<file>, line <n>: ..."): a malformed value
+  // inside one object costs that value (or that object), not the file.
+  std::vector<std::string> warnings;
 
   // Text of this file for display: Latin-1 bytes converted to UTF-8 when the file says so.
   std::string display(std::string_view text) const;

@@ -38,10 +38,33 @@ Result<EsiFlags> readFlags(const xml::Context& ctx, const Element* flags) {
   return out;
 }
 
+// DefaultData as hex bytes. A malformed one is a warning: the whole bytes before the fault are
+// kept (an odd last digit, or a character that is no hex digit, ends the value there) and the
+// object builder pads the rest with zeros, as for a short DefaultData.
+std::vector<std::uint8_t> readDefaultData(const xml::Context& ctx, const Element* data) {
+  const std::string_view raw = xml::text(data);
+  auto bytes = parseEsiHexBinary(raw);
+  if (bytes.ok()) return std::move(bytes).value();
+  std::string digits;
+  for (char c : raw) {
+    if (c == ' ' || c == '\t' || c == '\r' || c == '\n') continue;
+    if (std::isxdigit(static_cast<unsigned char>(c)) == 0) break;
+    digits += c;
+  }
+  digits.resize(digits.size() / 2 * 2);
+  auto kept = parseEsiHexBinary(digits);
+  std::vector<std::uint8_t> out = kept.ok() ? std::move(kept).value() : std::vector<std::uint8_t>{};
+  ctx.warn(data, "DefaultData '" + std::string(raw) + "': " + bytes.error().context + "; " +
+                     std::to_string(out.size()) + " whole byte(s) kept");
+  return out;
+}
+
 Result<EsiValueInfo> readValueInfo(const xml::Context& ctx, const Element* info) {
   EsiValueInfo out;
   if (info == nullptr) return out;
-  ECSIM_ASSIGN_OR_RETURN(out.defaultData, xml::childHex(ctx, info, "DefaultData"));
+  if (const Element* data = info->FirstChildElement("DefaultData"); data != nullptr) {
+    out.defaultData = readDefaultData(ctx, data);
+  }
   auto optionalText = [&](const char* name) -> std::optional<std::string> {
     const Element* e = info->FirstChildElement(name);
     if (e == nullptr) return std::nullopt;
@@ -90,6 +113,8 @@ Result<EsiObject> readObject(const xml::Context& ctx, const Element* e) {
   ECSIM_ASSIGN_OR_RETURN(auto index, xml::childNumber<std::uint32_t>(ctx, e, "Index"));
   if (!index) return ctx.error(e, "Object without Index");
   out.index = *index;
+  ECSIM_ASSIGN_OR_RETURN(out.dependOnSlot, xml::attrBool(ctx, e->FirstChildElement("Index"),
+                                                         "DependOnSlot", false));
   out.names = xml::localTexts(e, "Name");
   out.type = std::string(xml::childText(e, "Type"));
   ECSIM_ASSIGN_OR_RETURN(auto bitSize, xml::childNumber<std::uint32_t>(ctx, e, "BitSize"));
@@ -119,8 +144,13 @@ Status readDictionary(const xml::Context& ctx, const Element* dictionary, EsiDic
     out.dataTypes.push_back(std::move(type));
   }
   for (const Element* e : Children(dictionary->FirstChildElement("Objects"), "Object")) {
-    ECSIM_ASSIGN_OR_RETURN(auto object, readObject(ctx, e));
-    out.objects.push_back(std::move(object));
+    auto object = readObject(ctx, e);
+    if (!object.ok()) {
+      // One unreadable object (its Index, a number in its Info) costs that object only.
+      ctx.warn(object.error().context + "; the object is left out");
+      continue;
+    }
+    out.objects.push_back(std::move(object).value());
   }
   return okStatus();
 }

@@ -1,5 +1,7 @@
 // ESI reader: roots, vendor, groups, devices, modules and slots.
 
+#include <fmt/core.h>
+
 #include "config/esi_parts.hpp"
 #include "protocol/read_file.hpp"
 
@@ -152,10 +154,46 @@ Result<EsiEeprom> readEeprom(const Context& ctx, const Element* e) {
   return out;
 }
 
+// The ESC memory an SM of the ESI occupies: 3 x its length in 3-buffer mode (control byte
+// bits 0-1 = 00), 1 x in mailbox mode; an SM of length 1 is no buffer, only its byte (ESC
+// datasheet section I, SyncManager chapter; issue #15 item 3). Beckhoff_EM2xxx.xml has two
+// such 1-byte SMs side by side at 0x0F00/0x0F01 (line 31-32): they do not overlap.
+std::pair<std::uint32_t, std::uint32_t> smArea(const EsiSyncManager& sm) {
+  const bool buffered = (sm.controlByte & 0x03) == 0x00 && sm.defaultSize > 1;
+  return {sm.startAddress, sm.startAddress + sm.defaultSize * (buffered ? 3u : 1u)};
+}
+
+// SMs whose areas overlap are a warning (the device is still built as written: what the ESC
+// does with overlapping SMs is the ESC model's business).
+void warnOverlappingSyncManagers(const Context& ctx, const std::vector<EsiSyncManager>& sms,
+                                 const std::vector<const Element*>& elements) {
+  for (std::size_t i = 0; i < sms.size(); ++i) {
+    const auto [a0, a1] = smArea(sms[i]);
+    for (std::size_t j = i + 1; j < sms.size(); ++j) {
+      const auto [b0, b1] = smArea(sms[j]);
+      if (a0 == a1 || b0 == b1 || a1 <= b0 || b1 <= a0) continue;
+      ctx.warn(elements[j], fmt::format("Sm {} (0x{:04X}-0x{:04X}) overlaps Sm {} (line {}, "
+                                        "0x{:04X}-0x{:04X})",
+                                        j, b0, b1 - 1, i, elements[i]->GetLineNum(), a0, a1 - 1));
+    }
+  }
+}
+
 Status readSlots(const Context& ctx, const Element* e, std::vector<EsiSlot>& out) {
+  if (e == nullptr) return okStatus();
+  ECSIM_ASSIGN_OR_RETURN(auto indexIncrement,
+                         xml::attrNumber<std::uint32_t>(ctx, e, "SlotIndexIncrement"));
+  ECSIM_ASSIGN_OR_RETURN(auto pdoIncrement,
+                         xml::attrNumber<std::uint32_t>(ctx, e, "SlotPdoIncrement"));
   for (const Element* s : Children(e, "Slot")) {
     EsiSlot slot;
+    slot.line = s->GetLineNum();
     slot.name = std::string(xml::childText(s, "Name"));
+    ECSIM_ASSIGN_OR_RETURN(auto ownIndex,
+                           xml::attrNumber<std::uint32_t>(ctx, s, "SlotIndexIncrement"));
+    ECSIM_ASSIGN_OR_RETURN(auto ownPdo, xml::attrNumber<std::uint32_t>(ctx, s, "SlotPdoIncrement"));
+    slot.indexIncrement = ownIndex.value_or(indexIncrement.value_or(0));
+    slot.pdoIncrement = ownPdo.value_or(pdoIncrement.value_or(0));
     ECSIM_ASSIGN_OR_RETURN(auto min, xml::attrNumber<std::uint32_t>(ctx, s, "MinInstances"));
     ECSIM_ASSIGN_OR_RETURN(auto max, xml::attrNumber<std::uint32_t>(ctx, s, "MaxInstances"));
     slot.minInstances = min.value_or(0);
@@ -167,6 +205,8 @@ Status readSlots(const Context& ctx, const Element* e, std::vector<EsiSlot>& out
       ECSIM_ASSIGN_OR_RETURN(auto ident,
                              xml::parseNumber<std::uint32_t>(ctx, m, "ModuleIdent", xml::text(m)));
       slot.moduleIdents.push_back(ident);
+      ECSIM_ASSIGN_OR_RETURN(const bool isDefault, xml::attrBool(ctx, m, "Default", false));
+      if (isDefault && !slot.defaultModuleIdent) slot.defaultModuleIdent = ident;
     }
     out.push_back(std::move(slot));
   }
@@ -222,10 +262,13 @@ Result<EsiDevice> readDevice(const Context& ctx, const Element* e, const Element
     ECSIM_ASSIGN_OR_RETURN(auto fmmu, readFmmu(ctx, f));
     out.fmmus.push_back(std::move(fmmu));
   }
+  std::vector<const Element*> smElements;
   for (const Element* s : Children(e, "Sm")) {
     ECSIM_ASSIGN_OR_RETURN(auto sm, readSyncManager(ctx, s));
     out.syncManagers.push_back(std::move(sm));
+    smElements.push_back(s);
   }
+  warnOverlappingSyncManagers(ctx, out.syncManagers, smElements);
   ECSIM_TRY(readPdos(ctx, e, "RxPdo", out.rxPdos, pdoTemplates));
   ECSIM_TRY(readPdos(ctx, e, "TxPdo", out.txPdos, pdoTemplates));
   ECSIM_TRY(readMailbox(ctx, e->FirstChildElement("Mailbox"), out.mailbox));
@@ -368,10 +411,12 @@ Result<EsiModule> readModule(const Context& ctx, const Element* e) {
 }  // namespace esi_detail
 
 Result<EsiFile> parseEsi(std::string_view xmlText, std::string_view fileName) {
-  const Context ctx{std::string(fileName)};
+  std::vector<std::string> warnings;
+  const Context ctx{std::string(fileName), &warnings};
   tinyxml2::XMLDocument doc(true, tinyxml2::PRESERVE_WHITESPACE);
   ECSIM_TRY(xml::parseDocument(xmlText, ctx, doc));
   ECSIM_ASSIGN_OR_RETURN(EsiFile file, readDocument(ctx, doc));
+  file.warnings = std::move(warnings);
   file.encoding = xml::declaredEncoding(xmlText);
   return file;
 }

@@ -298,10 +298,14 @@ Result<SiiContents> makeSiiContents(const EsiDevice& device, std::uint32_t vendo
   }
   if (options.pdoCategories) {
     for (const auto& pdo : device.txPdos) {
-      if (pdo.sm) c.txPdos.push_back(siiPdo(pdo, strings, options.pdoNameStrings));
+      if (pdo.sm && pdo.inCoeRange()) {
+        c.txPdos.push_back(siiPdo(pdo, strings, options.pdoNameStrings));
+      }
     }
     for (const auto& pdo : device.rxPdos) {
-      if (pdo.sm) c.rxPdos.push_back(siiPdo(pdo, strings, options.pdoNameStrings));
+      if (pdo.sm && pdo.inCoeRange()) {
+        c.rxPdos.push_back(siiPdo(pdo, strings, options.pdoNameStrings));
+      }
     }
   }
   c.strings = strings.take();

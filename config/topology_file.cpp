@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "config/xml_util.hpp"
+#include "protocol/closest_name.hpp"
 #include "protocol/read_file.hpp"
 
 namespace ecsim {
@@ -134,6 +135,26 @@ Result<TopologySlave> parseSlave(const xml::Context& ctx, const Element* e,
       return ctx.error(param, "Param needs name and value attributes");
     }
     s.params.push_back({pname, value, param->GetLineNum()});
+  }
+  if (const char* moduleFile = e->Attribute("modules")) s.moduleFile = folder / moduleFile;
+  for (const Element* m : xml::Children(e, "Module")) {
+    TopologyModule module;
+    module.line = m->GetLineNum();
+    if (const char* type = m->Attribute("type")) module.type = type;
+    ECSIM_ASSIGN_OR_RETURN(module.ident, xml::attrNumber<std::uint32_t>(ctx, m, "ident"));
+    if (module.type.empty() == !module.ident.has_value()) {
+      return ctx.error(m, "Module needs either type=\"NAME\" or ident=\"#xIDENT\"");
+    }
+    for (const tinyxml2::XMLAttribute* a = m->FirstAttribute(); a != nullptr; a = a->Next()) {
+      const std::string_view attribute = a->Name();
+      if (attribute != "type" && attribute != "ident") {
+        return ctx.error(m, unknownNameText("Module attribute", attribute, {"type", "ident"}));
+      }
+    }
+    s.modules.push_back(std::move(module));
+  }
+  if ((!s.modules.empty() || !s.moduleFile.empty()) && s.esiFile.empty()) {
+    return ctx.error(e, "Slave '" + s.name + "': modules need a device from an ESI file (esi=)");
   }
   return s;
 }

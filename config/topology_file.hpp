@@ -39,6 +39,14 @@ struct TopologyParam {  // a device model parameter (<Param name= value=>)
   int line{0};
 };
 
+// A module in a slot of a modular device (<Module type="UR20-4DI-P"/> or ident="#x00091F84"),
+// in slot order.
+struct TopologyModule {
+  std::string type;                    // module <Type> text, or empty
+  std::optional<std::uint32_t> ident;  // ModuleIdent, or nullopt
+  int line{0};
+};
+
 struct TopologySlave {
   std::string name;
   // Device: from an ESI file (esiFile + productCode [+ revision]) or a built-in one.
@@ -57,6 +65,10 @@ struct TopologySlave {
   std::filesystem::path stateFile;    // persistent device state (e.g. absolute encoder)
   std::vector<TopologyParam> params;  // device model parameters, in the written order
   std::filesystem::path folder;       // the topology file's folder (for files params name)
+  // Modular devices: the modules in the slots (none given: the slots' default modules), and
+  // the ESI file holding them (empty: the device's file, then every ESI file in its folder).
+  std::vector<TopologyModule> modules;
+  std::filesystem::path moduleFile;
   int line{0};
 };
 

@@ -51,11 +51,21 @@ class Children {
   const char* name_;
 };
 
-// Error context: the file name used in messages ("<file>, line <n>: <what>").
+// Error context: the file name used in messages ("<file>, line <n>: <what>"), and where the
+// warnings of a tolerant reader go (values it replaced or left out; none kept when null).
 class Context {
  public:
-  explicit Context(std::string file) : file_(std::move(file)) {}
+  explicit Context(std::string file, std::vector<std::string>* warnings = nullptr)
+      : file_(std::move(file)), warnings_(warnings) {}
   const std::string& file() const { return file_; }
+
+  void warn(const Element* e, std::string_view message) const {
+    warn(error(e, message).context);
+  }
+  // A message that already names file and line (an Error's context).
+  void warn(std::string located) const {
+    if (warnings_ != nullptr) warnings_->push_back(std::move(located));
+  }
 
   Error error(int line, std::string_view message) const {
     return makeError(ErrorCode::kParse,
@@ -67,6 +77,7 @@ class Context {
 
  private:
   std::string file_;
+  std::vector<std::string>* warnings_;
 };
 
 // Element text (first text or CDATA child), trimmed; empty when absent.

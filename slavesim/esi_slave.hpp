@@ -11,7 +11,8 @@
 //              dictionary no mailbox reaches); ESI Virtual SMs are neither checked nor copied;
 //              ecsim's own devices get their model (IO terminal, CiA 402 drive) as its
 //              application, see devices/device_models.hpp.
-// Bootstrap (BOOT state) and modules/slots are not modelled.
+// Modular devices come with their modules already in `device` (config/esi_modules.hpp, done by
+// the topology builder). Bootstrap (BOOT state) is not modelled.
 #pragma once
 
 #include <cstdint>

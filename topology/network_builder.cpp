@@ -4,6 +4,10 @@
 
 #include <fstream>
 
+#include <algorithm>
+
+#include "config/esi_modules.hpp"
+#include "protocol/closest_name.hpp"
 #include "protocol/read_file.hpp"
 #include "protocol/sii.hpp"
 #include "slavesim/devices/device_params.hpp"
@@ -57,13 +61,8 @@ Result<std::unique_ptr<slavesim::Slave>> SlaveFactory::make(const TopologySlave&
   }
   if (!entry.builtin.empty()) return at(entry, "unknown built-in device '" + entry.builtin + "'");
   if (!entry.eepromFile.empty()) return makeFromEeprom(entry, esc.value_or(slavesim::kEt1100));
-  auto found = esiFiles_.find(entry.esiFile);
-  if (found == esiFiles_.end()) {
-    auto file = loadEsiFile(entry.esiFile);
-    if (!file.ok()) return file.takeError();
-    found = esiFiles_.emplace(entry.esiFile, std::move(file).value()).first;
-  }
-  const EsiFile& file = found->second;
+  ECSIM_ASSIGN_OR_RETURN(const EsiFile* loaded, esiFile(entry.esiFile));
+  const EsiFile& file = *loaded;
   const EsiDevice* device = nullptr;
   for (const auto& d : file.devices) {
     if (!d.hasProductCode || d.productCode != *entry.productCode) continue;
@@ -94,7 +93,8 @@ Result<std::unique_ptr<slavesim::Slave>> SlaveFactory::make(const TopologySlave&
       return s.takeError();
     }
   }
-  auto slave = slavesim::makeSlaveFromEsi(file, *device, entry.name, options);
+  ECSIM_ASSIGN_OR_RETURN(const EsiDevice configured, withModules(entry, file, *device));
+  auto slave = slavesim::makeSlaveFromEsi(file, configured, entry.name, options);
   if (!slave.ok()) return slave;
   if (auto* od = slavesim::objectDictionaryOf(**slave)) {
     for (const auto& input : entry.inputs) {
@@ -111,6 +111,80 @@ Result<std::unique_ptr<slavesim::Slave>> SlaveFactory::make(const TopologySlave&
     return at(entry, "this device has no objects to set inputs on");
   }
   return slave;
+}
+
+Result<const EsiFile*> SlaveFactory::esiFile(const std::filesystem::path& path) {
+  auto found = esiFiles_.find(path);
+  if (found == esiFiles_.end()) {
+    auto file = loadEsiFile(path);
+    if (!file.ok()) return file.takeError();
+    found = esiFiles_.emplace(path, std::move(file).value()).first;
+    warnings_.insert(warnings_.end(), found->second.warnings.begin(),
+                     found->second.warnings.end());
+  }
+  return &found->second;
+}
+
+Result<EsiDevice> SlaveFactory::withModules(const TopologySlave& entry, const EsiFile& file,
+                                            const EsiDevice& device) {
+  if (device.slots.empty()) {
+    if (!entry.modules.empty()) return at(entry, "device " + device.type + " has no slots");
+    return device;
+  }
+  EsiModuleCatalog catalog;
+  catalog.add(device.modules);
+  catalog.add(file);
+  std::vector<std::filesystem::path> others;
+  if (!entry.moduleFile.empty()) others.push_back(entry.moduleFile);
+  std::error_code ec;
+  std::vector<std::filesystem::path> folder;
+  for (const auto& f : std::filesystem::directory_iterator(entry.esiFile.parent_path(), ec)) {
+    if (f.path().extension() == ".xml" && f.path() != entry.esiFile) folder.push_back(f.path());
+  }
+  std::sort(folder.begin(), folder.end());
+  for (const auto& path : others) {
+    ECSIM_ASSIGN_OR_RETURN(const EsiFile* modules, esiFile(path));
+    catalog.add(*modules);
+  }
+  // The folder is searched only for modules not found so far (a real folder holds many ESI
+  // files; an unreadable one there is not this device's business).
+  auto findAll = [&]() -> bool {
+    for (const auto& m : entry.modules) {
+      if (m.ident ? catalog.findByIdent(*m.ident) == nullptr
+                  : catalog.findByType(m.type) == nullptr) {
+        return false;
+      }
+    }
+    return entry.modules.empty() ? defaultModules(device, catalog).ok() : true;
+  };
+  for (const auto& path : folder) {
+    if (findAll()) break;
+    if (std::find(others.begin(), others.end(), path) != others.end()) continue;
+    auto modules = esiFile(path);
+    if (modules.ok()) catalog.add(**modules);
+  }
+  std::vector<const EsiModule*> chosen;
+  if (entry.modules.empty()) {
+    auto defaults = defaultModules(device, catalog);
+    if (!defaults.ok()) return at(entry, defaults.error().context);
+    chosen = std::move(defaults).value();
+  }
+  for (const auto& m : entry.modules) {
+    const EsiModule* module = m.ident ? catalog.findByIdent(*m.ident) : catalog.findByType(m.type);
+    if (module == nullptr) {
+      const std::string what =
+          m.ident ? fmt::format("no module with ModuleIdent #x{:08X} in the ESI files", *m.ident)
+                  : unknownNameText("module type", m.type, catalog.typeNames());
+      return makeError(ErrorCode::kInvalidArgument,
+                       "line " + std::to_string(m.line) + ": " + what);
+    }
+    chosen.push_back(module);
+  }
+  std::vector<std::string> notes;
+  auto configured = instantiateModules(device, chosen, &notes);
+  if (!configured.ok()) return at(entry, configured.error().context);
+  for (auto& n : notes) warnings_.push_back("slave '" + entry.name + "': " + std::move(n));
+  return configured;
 }
 
 Result<Network> buildNetwork(const TopologyConfig& config) {
@@ -152,6 +226,7 @@ Result<Network> buildNetwork(const TopologyConfig& config) {
     }
     net.cables.push_back({link.name, link.toSlave, link.toPort});
   }
+  net.warnings.insert(net.warnings.end(), factory.warnings().begin(), factory.warnings().end());
   return net;
 }
 

@@ -33,12 +33,22 @@ struct Network {
 
 // Makes the slaves topology entries describe: built-in devices, and devices from ESI files
 // (slavesim/esi_slave.hpp), reading each ESI file once.
+// Modular devices get their modules (config/esi_modules.hpp): the entry's <Module> list, else
+// the slots' default modules, looked up in the entry's module file, the device's own file and
+// every other ESI file in the device file's folder.
 class SlaveFactory {
  public:
   Result<std::unique_ptr<slavesim::Slave>> make(const TopologySlave& entry);
+  // ESI warnings (malformed values the reader replaced) and module notes, once per file.
+  const std::vector<std::string>& warnings() const { return warnings_; }
 
  private:
+  Result<const EsiFile*> esiFile(const std::filesystem::path& path);
+  Result<EsiDevice> withModules(const TopologySlave& entry, const EsiFile& file,
+                                const EsiDevice& device);
+
   std::map<std::filesystem::path, EsiFile> esiFiles_;
+  std::vector<std::string> warnings_;
 };
 
 Result<Network> buildNetwork(const TopologyConfig& config);

@@ -305,6 +305,56 @@ void addMappedObjects(ObjectDictionary& od, const EsiPdo& pdo, bool rx,
   }
 }
 
+std::string hexList(const std::vector<std::uint16_t>& values) {
+  std::string out;
+  for (auto v : values) out += (out.empty() ? "" : ", ") + hex4(v);
+  return out;
+}
+
+// Writes `values` (`bytes` wide) into subindexes 1.. of a list object (PDO assignment, PDO
+// mapping, module list) and their count into sub 0, as defaults; a list with less room keeps
+// what fits, noted.
+template <typename Note>
+void fillList(Object& list, const std::vector<std::uint32_t>& values, std::size_t bytes,
+              Note& note) {
+  std::size_t n = 0;
+  for (; n < values.size() && n < 255; ++n) {
+    Entry* e = list.entry(static_cast<std::uint8_t>(n + 1));
+    if (e == nullptr || e->value.size() < bytes) break;
+    writeRawValue(e->value, values[n], 0);
+    e->defaultValue = e->value;
+  }
+  if (n < values.size()) {
+    note(hex4(list.index) + " has room for " + std::to_string(n) + " of " +
+         std::to_string(values.size()) + " entries");
+  }
+  if (Entry* sub0 = list.entry(0); sub0 != nullptr && !sub0->value.empty()) {
+    sub0->value[0] = static_cast<std::uint8_t>(n);
+    sub0->defaultValue = sub0->value;
+  }
+}
+
+// Modular device profile (ETG.5001): 0xF030 Configured Module List (what the master downloads
+// with DownloadModuleIdentList) and 0xF050 Detected Module List hold the module idents in slot
+// order, sub 0 the number of modules; both agree, as on a station built as configured.
+constexpr std::uint16_t kConfiguredModuleListIndex = 0xF030;
+constexpr std::uint16_t kDetectedModuleListIndex = 0xF050;
+
+template <typename Note>
+void setModuleLists(ObjectDictionary& od, const std::vector<std::uint32_t>& idents, Note& note) {
+  const auto count = static_cast<std::uint8_t>(std::min<std::size_t>(idents.size(), 255));
+  for (const std::uint16_t index : {kConfiguredModuleListIndex, kDetectedModuleListIndex}) {
+    if (!od.contains(index)) {
+      od.addArray(index,
+                  index == kConfiguredModuleListIndex ? "Configured Module List"
+                                                      : "Detected Module List",
+                  data_type::kUnsigned32, 32, count,
+                  index == kConfiguredModuleListIndex ? access::kReadWrite : access::kReadOnly);
+    }
+    fillList(*od.find(index), idents, 4, note);
+  }
+}
+
 }  // namespace
 
 ObjectDictionary buildObjectDictionary(const EsiDevice& device, const OdBuildOptions& options,
@@ -361,10 +411,10 @@ ObjectDictionary buildObjectDictionary(const EsiDevice& device, const OdBuildOpt
   for (int dir = 0; dir < 2; ++dir) {
     const bool rx = dir == 0;
     for (const EsiPdo& pdo : rx ? device.rxPdos : device.txPdos) {
-      if (!isPdoMappingIndex(pdo.index)) {
-        // EL1262 has a TxPdo 0x1C00, which would overwrite the SM types: CoE cannot name
-        // such a PDO, so it is left out (its SII PDO category still lists it).
-        note("PDO " + hex4(pdo.index) + " is outside 0x1600-0x17FF/0x1A00-0x1BFF: left out");
+      if (!pdo.inCoeRange()) {
+        // EL1262 has a TxPdo 0x1C00, which would overwrite the SM types: such a PDO is left
+        // out here and of the SII PDO categories (EsiPdo::inCoeRange).
+        note("PDO " + hex4(pdo.index) + " is outside 0x1600-0x1BFF: left out");
         continue;
       }
       PdoRules& rules = od.pdoRules(pdo.index);
@@ -376,19 +426,20 @@ ObjectDictionary buildObjectDictionary(const EsiDevice& device, const OdBuildOpt
       std::vector<MappedObject> entries = mappingOf(pdo);
       if (Object* existing = od.find(pdo.index); existing != nullptr) {
         limitWritesToPreOp(*existing, pdo.fixed);
-        if (!entries.empty() && mappedObjects(od, pdo.index).empty()) {
-          Entry* sub0 = existing->entry(0);
-          std::size_t n = 0;
-          for (; n < entries.size(); ++n) {
-            Entry* e = existing->entry(static_cast<std::uint8_t>(n + 1));
-            if (e == nullptr || e->value.size() < 4) break;
-            writeLe32(e->value, 0, entries[n].raw());
-            e->defaultValue = e->value;
+        const std::vector<MappedObject> esiMapping = mappedObjects(od, pdo.index);
+        const bool same = std::equal(esiMapping.begin(), esiMapping.end(), entries.begin(),
+                                     entries.end(), [](const auto& a, const auto& b) {
+                                       return a.raw() == b.raw();
+                                     });
+        if (!entries.empty() && !same) {
+          // As for the assignment: the PDO's own entries win over the dictionary's default.
+          if (!esiMapping.empty()) {
+            note(hex4(pdo.index) + ": the dictionary's default mapping differs from the PDO's "
+                 "entries (line " + std::to_string(pdo.line) + "); the PDO's entries are used");
           }
-          if (sub0 != nullptr && !sub0->value.empty()) {
-            sub0->value[0] = static_cast<std::uint8_t>(n);
-            sub0->defaultValue = sub0->value;
-          }
+          std::vector<std::uint32_t> raw;
+          for (const auto& m : entries) raw.push_back(m.raw());
+          fillList(*existing, raw, 4, note);
         }
         continue;
       }
@@ -413,29 +464,25 @@ ObjectDictionary buildObjectDictionary(const EsiDevice& device, const OdBuildOpt
     std::vector<std::uint16_t> assigned;
     std::size_t candidates = 0;
     for (const EsiPdo& pdo : outputs ? device.rxPdos : device.txPdos) {
-      if (!isPdoMappingIndex(pdo.index)) continue;
+      if (!pdo.inCoeRange()) continue;
       if (pdo.sm && *pdo.sm == sm) assigned.push_back(pdo.index);
       if (!pdo.sm || *pdo.sm == sm) ++candidates;
     }
     const auto index = static_cast<std::uint16_t>(kPdoAssignBase + sm);
     if (Object* existing = od.find(index); existing != nullptr) {
       limitWritesToPreOp(*existing, false);
-      std::vector<std::uint16_t> esiValues = assignedPdos(od, sm);
-      if (esiValues.empty() && !assigned.empty()) {
-        std::size_t n = 0;
-        for (; n < assigned.size(); ++n) {
-          Entry* e = existing->entry(static_cast<std::uint8_t>(n + 1));
-          if (e == nullptr || e->value.size() < 2) break;
-          writeLe16(e->value, 0, assigned[n]);
-          e->defaultValue = e->value;
+      const std::vector<std::uint16_t> esiValues = assignedPdos(od, sm);
+      if (!assigned.empty() && esiValues != assigned) {
+        // The device's own PDO description (the PDOs with Sm=n) wins over the dictionary's
+        // default, as the SII PDO categories built from the same description say: shared
+        // Beckhoff dictionaries name PDOs a terminal does not have (Beckhoff_AX2xxx.xml:
+        // 0x1C12 default 0x1701, RxPdo Sm="2" 0x1702).
+        if (!esiValues.empty()) {
+          note(hex4(index) + ": the dictionary's default assignment (" + hexList(esiValues) +
+               ") differs from the device's PDOs with Sm=" + std::to_string(sm) + " (" +
+               hexList(assigned) + "); the device's PDOs are used");
         }
-        if (Entry* sub0 = existing->entry(0); sub0 != nullptr && !sub0->value.empty()) {
-          sub0->value[0] = static_cast<std::uint8_t>(n);
-          sub0->defaultValue = sub0->value;
-        }
-      } else if (esiValues != assigned) {
-        note(hex4(index) + ": ESI default assignment differs from the PDOs with Sm=" +
-             std::to_string(sm) + "; the dictionary's default is used");
+        fillList(*existing, {assigned.begin(), assigned.end()}, 2, note);
       }
       continue;
     }
@@ -454,6 +501,7 @@ ObjectDictionary buildObjectDictionary(const EsiDevice& device, const OdBuildOpt
     addSyncManagerParameters(od, kSmOutputParameterIndex, sync);
   if (!od.contains(kSmInputParameterIndex))
     addSyncManagerParameters(od, kSmInputParameterIndex, sync);
+  if (!device.moduleIdents.empty()) setModuleLists(od, device.moduleIdents, note);
   return od;
 }
 

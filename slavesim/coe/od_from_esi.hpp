@@ -15,8 +15,11 @@
 // 0x100A and 0x1C32/0x1C33 when the ESI has none; 0x1018 always carries the given identity;
 // 0x1C00 from the <Sm> list; a mapping object per <RxPdo>/<TxPdo> (read-only when Fixed,
 // else writable in PREOP); 0x1C10+n per process-data SM holding the PDOs whose Sm attribute
-// is n. ESI definitions of these objects are kept (their writes limited to PREOP), filled from
-// the PDO list only when the ESI leaves them empty. Objects that PDO entries map but the
+// is n. ESI definitions of these objects are kept (their writes limited to PREOP); their defaults
+// come from the device's own PDO description (Sm attributes, PDO entries) when the ESI leaves
+// them empty or says otherwise (a shared dictionary naming PDOs the device does not have; the
+// difference is noted), zero entries in an assignment count as absent. A modular device's
+// module idents (EsiDevice::moduleIdents) fill 0xF030/0xF050. Objects that PDO entries map but the
 // dictionary lacks (devices without a dictionary) are created, read-only for inputs and
 // read-write for outputs, and every mapped entry is marked RX/TX mappable.
 #pragma once

@@ -136,7 +136,11 @@ std::vector<std::uint16_t> assignedPdos(const ObjectDictionary& od, unsigned sm)
   for (std::uint8_t i = 1; i <= count && i != 0; ++i) {
     const Entry* e = o->entry(i);
     if (e == nullptr) break;
-    out.push_back(static_cast<std::uint16_t>(readRawValue(e->value, 16)));
+    // A zero entry assigns nothing and is skipped, as masters skip it (a dynamic-PDO device
+    // with 0x1C12:03 = 0 in its ESI defaults; issue #15 item 11).
+    if (const auto pdo = static_cast<std::uint16_t>(readRawValue(e->value, 16)); pdo != 0) {
+      out.push_back(pdo);
+    }
   }
   return out;
 }

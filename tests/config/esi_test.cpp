@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 #include "config/esi.hpp"
 
@@ -300,6 +301,60 @@ TEST(EsiReader, BadNumberNamesItsLine) {
   EXPECT_NE(file.error().context.find("num.xml, line 3"), std::string::npos)
       << file.error().context;
   EXPECT_NE(file.error().context.find("ProductCode"), std::string::npos);
+}
+
+// Issue #15 item 11: a malformed value inside one object (DefaultData with an odd number of hex
+// digits, an Index that is no number) must not make the file unusable: a warning naming file
+// and line, the nearest sensible value (the whole bytes written; the object left out when even
+// its index is unreadable), and the rest of the file as written.
+TEST(EsiReader, MalformedValueInsideAnObjectIsAWarning) {
+  const char* text =
+      "<EtherCATInfo><Descriptions><Devices><Device>\n"
+      "<Type ProductCode=\"#x1\">X</Type><Profile><Dictionary><Objects>\n"
+      "<Object><Index>#x2000</Index><Name>Odd</Name><Type>UDINT</Type><BitSize>32</BitSize>\n"
+      "<Info><DefaultData>0A1</DefaultData></Info></Object>\n"
+      "<Object><Index>#xZZ</Index><Name>Bad</Name><Type>UINT</Type><BitSize>16</BitSize>"
+      "</Object>\n"
+      "<Object><Index>#x2002</Index><Name>Good</Name><Type>UINT</Type><BitSize>16</BitSize>"
+      "<Info><DefaultData>3412</DefaultData></Info></Object>\n"
+      "</Objects></Dictionary></Profile></Device></Devices></Descriptions></EtherCATInfo>";
+  auto file = parseEsi(text, "odd.xml");
+  ASSERT_TRUE(file.ok()) << file.error().message();
+  const EsiDictionary& dict = file->devices.at(0).dictionary;
+  ASSERT_EQ(dict.objects.size(), 2u);
+  const EsiObject* odd = dict.findObject(0x2000);
+  ASSERT_NE(odd, nullptr);
+  EXPECT_EQ(odd->info.defaultData, std::vector<std::uint8_t>{0x0A}) << "the whole byte kept";
+  ASSERT_NE(dict.findObject(0x2002), nullptr);
+  EXPECT_EQ(dict.findObject(0x2002)->info.defaultData, (std::vector<std::uint8_t>{0x34, 0x12}));
+  ASSERT_EQ(file->warnings.size(), 2u);
+  EXPECT_NE(file->warnings[0].find("odd.xml, line 4"), std::string::npos) << file->warnings[0];
+  EXPECT_NE(file->warnings[0].find("odd number of hex digits"), std::string::npos);
+  EXPECT_NE(file->warnings[1].find("odd.xml, line 5"), std::string::npos) << file->warnings[1];
+  EXPECT_NE(file->warnings[1].find("left out"), std::string::npos) << file->warnings[1];
+}
+
+// Issue #15 item 11: SMs that overlap in the ESI are a warning naming both; the device is read
+// as written. A 3-buffer SM takes 3 x its length (ESC datasheet section I, SyncManager
+// chapter); an SM of length 1 is no buffer and takes its one byte (Beckhoff_EM2xxx.xml's
+// 0x0F00/0x0F01 pair, see EsiCorpus: no warning there).
+TEST(EsiReader, OverlappingSyncManagersAreAWarning) {
+  const char* text =
+      "<EtherCATInfo><Descriptions><Devices><Device>\n"
+      "<Type ProductCode=\"#x1\">X</Type>\n"
+      "<Sm StartAddress=\"#x1100\" DefaultSize=\"8\" ControlByte=\"#x64\">Outputs</Sm>\n"
+      "<Sm StartAddress=\"#x1110\" DefaultSize=\"4\" ControlByte=\"#x20\">Inputs</Sm>\n"  // 3 x 4
+      "<Sm StartAddress=\"#x0F00\" DefaultSize=\"1\" ControlByte=\"#x44\">Outputs</Sm>\n"
+      "<Sm StartAddress=\"#x0F01\" DefaultSize=\"1\" ControlByte=\"#x44\">Outputs</Sm>\n"
+      "</Device></Devices></Descriptions></EtherCATInfo>";
+  auto file = parseEsi(text, "sm.xml");
+  ASSERT_TRUE(file.ok()) << file.error().message();
+  ASSERT_EQ(file->devices.at(0).syncManagers.size(), 4u) << "read as written";
+  ASSERT_EQ(file->warnings.size(), 1u);
+  EXPECT_NE(file->warnings[0].find("sm.xml, line 4: Sm 1 (0x1110-0x111B) overlaps Sm 0 (line 3, "
+                                   "0x1100-0x1117)"),
+            std::string::npos)
+      << file->warnings[0];
 }
 
 TEST(EsiReader, UnknownRootIsAnError) {

@@ -66,6 +66,25 @@ TEST(TopologyFile, DevicesWiringClocksAndInputs) {
   EXPECT_EQ(t->links[1].name, "J:1-Drive:0");
 }
 
+TEST(TopologyFile, ModulesOfAModularDevice) {
+  auto t = parseTopology(R"(<Topology>
+  <Slave name="Station" esi="Weidmueller_UR20_FBC.xml" product="#x4F911C30"
+         modules="Weidmueller_UR20_IO.xml">
+    <Module type="UR20-4DI-P"/>
+    <Module ident="#x01012FA0"/>
+  </Slave>
+</Topology>)",
+                         kFile);
+  ASSERT_TRUE(t.ok()) << t.error().message();
+  const TopologySlave& s = t->slaves.at(0);
+  EXPECT_EQ(s.moduleFile, std::filesystem::path("/some/dir/Weidmueller_UR20_IO.xml"));
+  ASSERT_EQ(s.modules.size(), 2u);
+  EXPECT_EQ(s.modules[0].type, "UR20-4DI-P");
+  EXPECT_FALSE(s.modules[0].ident.has_value());
+  EXPECT_EQ(s.modules[1].ident, 0x01012FA0u);
+  EXPECT_EQ(s.modules[1].line, 5);
+}
+
 struct BadCase {
   const char* xml;
   const char* expect;  // part of the message, including the line
@@ -126,7 +145,16 @@ INSTANTIATE_TEST_SUITE_P(
                 "line 3: attribute driftPpm: 'nan' is not a number in [-1000, 1000] ppm"},
         BadCase{"<Topology>\n<Slave name=\"A\">\n<Clock driftPpm=\"-inf\"/>\n</Slave>\n"
                 "</Topology>",
-                "line 3: attribute driftPpm: '-inf' is not a number in [-1000, 1000]"}));
+                "line 3: attribute driftPpm: '-inf' is not a number in [-1000, 1000]"},
+        // Modules of a modular device: type or ident, strict attributes, ESI devices only.
+        BadCase{"<Topology>\n<Slave name=\"A\" esi=\"h.xml\" product=\"1\">\n<Module/>\n"
+                "</Slave>\n</Topology>",
+                "line 3: Module needs either type"},
+        BadCase{"<Topology>\n<Slave name=\"A\" esi=\"h.xml\" product=\"1\">\n"
+                "<Module type=\"X\" idents=\"1\"/>\n</Slave>\n</Topology>",
+                "line 3: unknown Module attribute 'idents'; did you mean 'ident'?"},
+        BadCase{"<Topology>\n<Slave name=\"A\">\n<Module type=\"X\"/>\n</Slave>\n</Topology>",
+                "line 2: Slave 'A': modules need a device from an ESI file"}));
 
 std::string slaves(std::size_t n) {
   std::string xml = "<Topology>\n";

@@ -323,11 +323,34 @@ TEST(OdRealEsi, BeckhoffStepperAndServoAssignments) {
   ASSERT_TRUE(servo.ok());
   coe::OdBuildReport report;
   auto axOd = coe::buildObjectDictionary(servo->devices.at(0), {servo->vendor.id, 0, 8}, &report);
-  // The dictionary's own 0x1C12 default (0x1701) wins over the PDO marked Sm="2" (0x1702);
-  // the difference is reported.
-  EXPECT_EQ(coe::assignedPdos(axOd, 2), (std::vector<std::uint16_t>{0x1701}));
+  // Issue #15 item 11: the device's own PDO description wins over the shared dictionary's
+  // default. Beckhoff_AX2xxx.xml: 0x1C12's default names 0x1701 (object at line 3112), the
+  // device marks RxPdo 0x1702 Sm="2" (line 10417); the SII PDO category says 0x1702 too.
+  // The difference is reported.
+  EXPECT_EQ(coe::assignedPdos(axOd, 2), (std::vector<std::uint16_t>{0x1702}));
   ASSERT_EQ(report.notes.size(), 2u);
   EXPECT_NE(report.notes[0].find("0x1C12"), std::string::npos);
+  EXPECT_NE(report.notes[0].find("the device's PDOs are used"), std::string::npos)
+      << report.notes[0];
+  auto layout = slavesim::computeProcessDataLayout(axOd);
+  ASSERT_TRUE(layout.ok()) << layout.error().message();
+  ASSERT_FALSE(layout->empty());
+  std::uint32_t bits = 0;
+  for (const auto& pdo : servo->devices.at(0).rxPdos) bits += pdo.index == 0x1702 ? pdo.bitLength() : 0;
+  EXPECT_EQ((*layout)[0].bitLength, bits) << "what the slave accepts at PREOP->SAFEOP";
+}
+
+// Issue #15 item 11: a zero entry in a PDO assignment (0x1C12:02 = 0 with sub 0 = 2, as a
+// dynamic-PDO device's defaults write it) is skipped, as masters skip it, not refused as
+// "PDO 0x0000 does not exist".
+TEST_F(InlineEsi, ZeroEntryInAnAssignmentIsSkipped) {
+  ASSERT_TRUE(od_.set<std::uint8_t>(0x1C12, 0, 2).ok());
+  ASSERT_TRUE(od_.set<std::uint16_t>(0x1C12, 1, 0x1600).ok());
+  ASSERT_TRUE(od_.set<std::uint16_t>(0x1C12, 2, 0).ok());
+  EXPECT_EQ(coe::assignedPdos(od_, 2), (std::vector<std::uint16_t>{0x1600}));
+  auto layout = slavesim::computeProcessDataLayout(od_);
+  ASSERT_TRUE(layout.ok()) << layout.error().message();
+  EXPECT_EQ((*layout)[0].bitLength, 48u) << "0x1600: 0x6040 (16) + 0x607A (32)";
 }
 
 TEST(OdRealEsi, CouplerWithoutDictionaryGetsTheStandardObjectsOnly) {
