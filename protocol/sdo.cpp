@@ -210,15 +210,14 @@ Error badSpecifier(std::uint8_t cs, bool request, std::size_t base) {
                    std::to_string(cs) + " is not valid");
 }
 
-Result<CoeMessage> decodeSdoMailbox(ConstBytes buffer, CoeService expected) {
-  ECSIM_ASSIGN_OR_RETURN(CoeMessage message, decodeCoeMailbox(buffer));
+Status expectService(const CoeMessage& message, CoeService expected) {
   if (message.coe.service != expected) {
     return fault(ErrorCode::kMalformed, 7,
                  "CoE service " + std::to_string(static_cast<unsigned>(message.coe.service)) +
                      " (" + std::string(toString(message.coe.service)) + ") is not " +
                      std::string(toString(expected)));
   }
-  return message;
+  return okStatus();
 }
 
 }  // namespace
@@ -375,17 +374,32 @@ Result<std::size_t> encodeSdoResponseMailbox(Bytes out, const SdoResponse& respo
   if (out.size() < kCoeBodyOffset) return tooSmall("SDO mailbox", kCoeBodyOffset, out.size());
   ECSIM_ASSIGN_OR_RETURN(std::size_t body,
                          encodeSdoResponse(out.subspan(kCoeBodyOffset), response));
-  return finishCoeMailbox(out, mailbox, CoeHeader{0, CoeService::kSdoResponse}, body);
+  // Abort SDO Transfer is an SDO request in either direction (ETG.1000.6 table of CoE
+  // services; SOES esc_coe.c SDO_abort() writes COE_SDOREQUEST): a slave's abort carries
+  // service 2. SOEM takes a service-3 answer with the right index as success and never sees
+  // the abort code (ethercatcoe.c / ec_coe.c ecx_SDOwrite, ecx_SDOread).
+  const CoeService service = std::holds_alternative<SdoAbort>(response) ? CoeService::kSdoRequest
+                                                                       : CoeService::kSdoResponse;
+  return finishCoeMailbox(out, mailbox, CoeHeader{0, service}, body);
 }
 
 Result<SdoRequestMessage> decodeSdoRequestMailbox(ConstBytes buffer) {
-  ECSIM_ASSIGN_OR_RETURN(CoeMessage m, decodeSdoMailbox(buffer, CoeService::kSdoRequest));
+  ECSIM_ASSIGN_OR_RETURN(CoeMessage m, decodeCoeMailbox(buffer));
+  ECSIM_TRY(expectService(m, CoeService::kSdoRequest));
   ECSIM_ASSIGN_OR_RETURN(SdoRequest sdo, decodeRequestAt(m.body, kCoeBodyOffset));
   return SdoRequestMessage{m.mailbox, m.coe, sdo};
 }
 
 Result<SdoResponseMessage> decodeSdoResponseMailbox(ConstBytes buffer) {
-  ECSIM_ASSIGN_OR_RETURN(CoeMessage m, decodeSdoMailbox(buffer, CoeService::kSdoResponse));
+  ECSIM_ASSIGN_OR_RETURN(CoeMessage m, decodeCoeMailbox(buffer));
+  // A slave's abort comes as service 2 (as ETG.1000.6 and SOES send it) or, from some slaves
+  // in the field, as service 3: both are the slave's answer.
+  if (m.coe.service == CoeService::kSdoRequest && !m.body.empty() &&
+      (m.body[0] >> kCsShift) == kCsAbort) {
+    ECSIM_TRY(checkBody(m.body, kCoeBodyOffset));
+    return SdoResponseMessage{m.mailbox, m.coe, SdoResponse{decodeAbort(m.body)}};
+  }
+  ECSIM_TRY(expectService(m, CoeService::kSdoResponse));
   ECSIM_ASSIGN_OR_RETURN(SdoResponse sdo, decodeResponseAt(m.body, kCoeBodyOffset));
   return SdoResponseMessage{m.mailbox, m.coe, sdo};
 }

@@ -1,5 +1,7 @@
 // SDO transfers over CoE (CiA 301 §7.2.4.3 as carried by ETG.1000.6 §5.6.2): requests
 // (CoE service 2, master -> slave) and responses (service 3), plus the SDO abort codes.
+// Abort SDO Transfer is a request in either direction: a slave's abort travels as CoE
+// service 2 (ETG.1000.6 table of CoE services; SOES SDO_abort() sends COE_SDOREQUEST).
 //
 // SDO body (everything after the CoE header), at least 8 bytes:
 //   byte 0      command: bits 5-7 command specifier, bits 0-4 depend on it (below)
@@ -173,15 +175,19 @@ struct SdoResponseMessage {
   SdoResponse sdo;
 };
 
-// Writes a complete mailbox (type CoE, CoE service 2 or 3, number 0) into out, typically the
-// SyncManager buffer; returns the bytes written (6 + mailbox length). Address, channel,
-// priority and counter come from `mailbox`. Bytes of out after the message are not touched.
+// Writes a complete mailbox (type CoE, CoE service 2 for a request, 3 for a response, number
+// 0) into out, typically the SyncManager buffer; returns the bytes written (6 + mailbox
+// length). A slave's SdoAbort is written with service 2, as real slaves send it. Address,
+// channel, priority and counter come from `mailbox`. Bytes of out after the message are not
+// touched.
 Result<std::size_t> encodeSdoRequestMailbox(Bytes out, const SdoRequest& request,
                                             MailboxHeader mailbox = {});
 Result<std::size_t> encodeSdoResponseMailbox(Bytes out, const SdoResponse& response,
                                              MailboxHeader mailbox = {});
 // Decodes a mailbox buffer (bytes after the mailbox length are ignored) that must carry a CoE
-// SDO request (service 2) / response (service 3). Errors name the byte offset within `buffer`.
+// SDO request (service 2) / response (service 3). A response may also be an abort under
+// service 2 (the standard form) or 3 (sent by some slaves in the field): both decode to
+// SdoAbort. Errors name the byte offset within `buffer`.
 Result<SdoRequestMessage> decodeSdoRequestMailbox(ConstBytes buffer);
 Result<SdoResponseMessage> decodeSdoResponseMailbox(ConstBytes buffer);
 // The results view the buffer: decoding a temporary vector would leave them dangling.

@@ -46,7 +46,7 @@ Result<std::vector<ProcessDataSmLayout>> computeProcessDataLayout(const coe::Obj
                                                    ", which does not exist");
       }
       for (const coe::MappedObject& m : coe::mappedObjects(od, pdo)) {
-        if (m.index != 0) {
+        if (!m.isPadding()) {
           const coe::Entry* e = od.findEntry(m.index, m.subindex);
           if (e == nullptr) {
             return makeError(ErrorCode::kNotFound, "PDO " + hex4(pdo) + " maps " + hex4(m.index) +
@@ -82,7 +82,7 @@ Status ProcessDataBinding::bind(coe::ObjectDictionary& od, std::uint32_t skip) {
     if (sm.sm < 32 && (skip & (1u << sm.sm)) != 0) continue;
     std::uint32_t offset = 0;
     for (const coe::MappedObject& m : sm.entries) {
-      if (m.index != 0 && m.bitLength > 0) {
+      if (!m.isPadding() && m.bitLength > 0) {
         coe::Entry* e = od.findEntry(m.index, m.subindex);
         copies_.push_back({buffer, offset, m.bitLength, e->value.data(), e->value.size()});
       }

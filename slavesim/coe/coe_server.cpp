@@ -159,6 +159,8 @@ void CoeServer::sendSdo(const SdoResponse& response) {
   queue(std::move(message));
 }
 
+// Goes out as CoE service 2, an SDO request, as real slaves send it (encodeSdoResponseMailbox;
+// ETG.1000.6, SOES SDO_abort()): SOEM takes a service-3 abort for success.
 void CoeServer::sendAbort(std::uint16_t index, std::uint8_t subindex, std::uint32_t abort) {
   ++counters_.aborts;
   sendSdo(SdoAbort{index, subindex, abort});

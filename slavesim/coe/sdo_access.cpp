@@ -31,6 +31,11 @@ SdoResult checkMappingEntry(const ObjectDictionary& od, std::uint16_t mappingInd
                             std::uint32_t raw) {
   const MappedObject m = MappedObject::fromRaw(raw);
   if (m.index == 0) return kSdoOk;  // a gap
+  if (m.isPadding()) {  // a dummy entry: subindex 0 and exactly its type's length
+    return m.subindex == 0 && m.bitLength == dummyEntryBits(m.index)
+               ? kSdoOk
+               : abortCode(SdoAbortCode::kObjectCannotBeMapped);
+  }
   const Entry* e = od.findEntry(m.index, m.subindex);
   const bool rx = isRxPdoMappingIndex(mappingIndex);
   // A mapping may take fewer bits than the entry has (Beckhoff maps 64-bit latch times with 32

@@ -132,6 +132,41 @@ TEST_F(CoeClientTest, AbortsAreDecodedToText) {
       << readOnly.error().context;
 }
 
+// A slave that answers every SDO request with an abort (0x06010002 for the requested
+// index:subindex) under a chosen CoE service: 2 as ETG.1000.6 and SOES send it, or 3 as some
+// slaves in the field do.
+class AbortingMailbox : public slavesim::MailboxServer {
+ public:
+  explicit AbortingMailbox(std::uint8_t service) : service_(service) {}
+  void onRequest(slavesim::Esc& esc, ConstBytes mailbox, SimTime) override {
+    if (mailbox.size() < 12) return;
+    const std::uint8_t answer[16] = {
+        0x0a, 0x00, 0x00, 0x00, 0x00, static_cast<std::uint8_t>(0x03 | (mailbox[5] & 0x70)),
+        0x00, static_cast<std::uint8_t>(service_ << 4), 0x80, mailbox[9], mailbox[10],
+        mailbox[11], 0x02, 0x00, 0x01, 0x06};
+    (void)esc.pdiMailboxSend(answer);
+  }
+
+ private:
+  std::uint8_t service_;
+};
+
+TEST_F(CoeClientTest, AbortIsAcceptedUnderCoeServiceTwoOrThree) {
+  for (std::uint8_t service : {std::uint8_t{2}, std::uint8_t{3}}) {
+    net_.segment().slave(1).setMailboxServer(std::make_unique<AbortingMailbox>(service));
+    auto status = download(1, 0x6040, 0, {0x0F, 0x00});
+    ASSERT_FALSE(status.ok()) << "service " << int(service);
+    EXPECT_EQ(status.error().code, ErrorCode::kAborted) << status.error().message();
+    EXPECT_EQ(sdo_->abortCode(), 0x06010002u) << "service " << int(service);
+    std::vector<std::uint8_t> data;
+    status = upload(1, 0x1018, 1, false, data);
+    ASSERT_FALSE(status.ok());
+    EXPECT_EQ(sdo_->abortCode(), 0x06010002u) << "service " << int(service);
+    EXPECT_NE(status.error().context.find("0x1018:01"), std::string::npos)
+        << status.error().context;
+  }
+}
+
 TEST_F(CoeClientTest, CompleteAccessUploadOfARecord) {
   std::vector<std::uint8_t> data;
   auto status = upload(2, 0x1018, 0, true, data);

@@ -329,13 +329,54 @@ TEST(SdoMailbox, EveryRequestAndResponseRoundTrips) {
   }
 }
 
-TEST(SdoMailbox, AbortLayout) {
+// A slave's Abort SDO Transfer is a CoE SDO *request* (service 2): ETG.1000.6 table of CoE
+// services, and SOES esc_coe.c SDO_abort() builds it with COE_SDOREQUEST. SOEM (v1.4
+// ethercatcoe.c, v2 ec_coe.c, ecx_SDOwrite/ecx_SDOread) takes a service-3 answer whose index
+// matches as the normal answer, so only a service-2 abort reaches its ECT_SDO_ABORT branch.
+TEST(SdoMailbox, SlaveAbortIsAnSdoRequestOnTheWire) {
   std::vector<std::uint8_t> sm(16, 0xEE);
   auto n = encodeSdoResponseMailbox(sm, SdoAbort{0x1C00, 0, 0x06010004});
   ASSERT_TRUE(n.ok());
   EXPECT_EQ(*n, 16u);
-  EXPECT_EQ(sm, (std::vector<std::uint8_t>{0x0a, 0x00, 0x00, 0x00, 0x00, 0x03, 0x00, 0x30, 0x80,
-                                           0x00, 0x1c, 0x00, 0x04, 0x00, 0x01, 0x06}));
+  EXPECT_EQ(sm, (std::vector<std::uint8_t>{
+                    0x0a, 0x00,              // mailbox length 10
+                    0x00, 0x00,              // address
+                    0x00,                    // channel, priority
+                    0x03,                    // type 3 CoE, counter 0
+                    0x00, 0x20,              // CoE number 0, service 2 in bits 12-15
+                    0x80,                    // command specifier 4: abort
+                    0x00, 0x1c, 0x00,        // index 0x1C00, subindex 0
+                    0x04, 0x00, 0x01, 0x06}  // abort code 0x06010004, little-endian
+                ));
+}
+
+TEST(SdoMailbox, AbortIsAcceptedUnderEitherService) {
+  // Service 2 (the standard, SOES) and service 3 (seen from slaves in the field) both decode
+  // as the slave's abort.
+  for (int service : {2, 3}) {
+    const std::vector<std::uint8_t> sm{0x0a, 0x00, 0x00, 0x00, 0x00, 0x03,
+                                       0x00, static_cast<std::uint8_t>(service << 4),
+                                       0x80, 0x18, 0x10, 0x01, 0x02, 0x00, 0x01, 0x06};
+    auto back = decodeSdoResponseMailbox(sm);
+    ASSERT_TRUE(back.ok()) << "service " << service << ": " << back.error().message();
+    const SdoResponse expected = SdoAbort{0x1018, 1, 0x06010002};
+    EXPECT_EQ(back->sdo, expected) << service;
+  }
+  // Service 2 carries nothing else a slave may answer with.
+  std::vector<std::uint8_t> sm(64, 0);
+  ASSERT_TRUE(encodeSdoRequestMailbox(sm, SdoInitiateDownloadRequest{
+                                              0x1000, 0, false, true, false, 4,
+                                              std::vector<std::uint8_t>{1, 2, 3, 4}})
+                  .ok());
+  auto notAbort = decodeSdoResponseMailbox(sm);
+  ASSERT_FALSE(notAbort.ok());
+  EXPECT_TRUE(mentions(notAbort.error(), "byte 7")) << notAbort.error().context;
+  // A short service-2 abort names its missing bytes.
+  std::vector<std::uint8_t> shortAbort{0x05, 0x00, 0x00, 0x00, 0x00, 0x03, 0x00, 0x20, 0x80,
+                                       0x18, 0x10};
+  auto truncated = decodeSdoResponseMailbox(shortAbort);
+  ASSERT_FALSE(truncated.ok());
+  EXPECT_EQ(truncated.error().code, ErrorCode::kTruncated);
 }
 
 // --- abort codes ----------------------------------------------------------------------------

@@ -8,12 +8,6 @@
 namespace ecsim::testing {
 namespace {
 
-std::vector<std::uint8_t> bytesOf(std::uint32_t v, std::size_t n) {
-  std::vector<std::uint8_t> out(n);
-  for (std::size_t i = 0; i < n; ++i) out[i] = static_cast<std::uint8_t>(v >> (8 * i));
-  return out;
-}
-
 void disableProcessDataSms(topology::Segment& seg) {
   one(seg, Command::kFpwr, phys(kStation, reg::smChannel(2) + reg::sm::kActivate.address), {0});
   one(seg, Command::kFpwr, phys(kStation, reg::smChannel(3) + reg::sm::kActivate.address), {0});

@@ -129,6 +129,11 @@ TEST(CoeSdoInfo, Errors) {
   EXPECT_EQ(std::get<SdoInfoError>(*reply.response).abortCode, 0x06090011u);
   reply = t.master->info(OdListRequest{9});
   EXPECT_EQ(std::get<SdoInfoError>(*reply.response).abortCode, 0x06090030u);
+  // An SDO-information error keeps its own service (8) and opcode 7 (ETG.1000.6 SDO
+  // information services); it is not an SDO abort.
+  ASSERT_EQ(reply.raw.size(), 1u);
+  EXPECT_EQ(readLe16(reply.raw.front(), 6) >> 12, 8);
+  EXPECT_EQ(reply.raw.front()[8] & 0x7F, 0x07);
 }
 
 TEST(CoeSdoInfo, NotServedWhenTheDeviceHasNoSdoInfo) {

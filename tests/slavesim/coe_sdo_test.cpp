@@ -11,12 +11,6 @@ namespace {
 
 using slavesim::coe::CoeServerOptions;
 
-std::vector<std::uint8_t> bytesOf(std::uint32_t v, std::size_t n) {
-  std::vector<std::uint8_t> out(n);
-  for (std::size_t i = 0; i < n; ++i) out[i] = static_cast<std::uint8_t>(v >> (8 * i));
-  return out;
-}
-
 TEST(CoeSdo, ExpeditedUploadAnswersWithTheObjectsOwnSize) {
   CoeTestSlave t;
   // Command bytes of the initiate upload response (scs 2, expedited, size indicated, n unused
@@ -118,6 +112,33 @@ TEST(CoeSdo, AbortCodes) {
   EXPECT_EQ(t.master->download(0x1C12, 0, {0}), 0u);
   EXPECT_EQ(t.master->download(0x1C12, 1, bytesOf(0x1A00, 2)), 0x06090030u);
   EXPECT_EQ(t.master->download(0x1C12, 0, {3}), 0x06090031u) << "more than the 2 entries";
+}
+
+// The server's aborts are CoE SDO requests, service 2 (ETG.1000.6 table of CoE services;
+// SOES esc_coe.c SDO_abort() sends COE_SDOREQUEST): in answer to an initiate upload, an
+// initiate download and a segment alike. Mailbox type 3, command 0x80.
+TEST(CoeSdo, EveryAbortTravelsAsCoeServiceTwo) {
+  CoeTestSlave t;
+  auto expectAbortOnWire = [&](std::uint32_t code, const char* what) {
+    const auto& m = t.master->lastReply();
+    ASSERT_GE(m.size(), 16u) << what;
+    EXPECT_EQ(m[5] & 0x0F, 3) << what << ": mailbox type CoE";
+    EXPECT_EQ(readLe16(m, 6), 0x2000) << what << ": CoE service 2, number 0";
+    EXPECT_EQ(m[8], 0x80) << what;
+    EXPECT_EQ(readLe32(m, 12), code) << what;
+  };
+  EXPECT_EQ(t.master->upload(0x6FFF, 0).abort, 0x06020000u);
+  expectAbortOnWire(0x06020000, "initiate upload of a missing object");
+  EXPECT_EQ(t.master->download(0x1018, 1, bytesOf(1, 4)), 0x06010002u);
+  expectAbortOnWire(0x06010002, "expedited download to a read-only entry");
+  std::vector<std::uint8_t> blob(200, 0xAB);
+  auto r = t.master->sdoTransact(
+      SdoInitiateDownloadRequest{0x2003, 0, false, false, true, 200, ConstBytes(blob).first(112)});
+  ASSERT_TRUE(r && std::holds_alternative<SdoAbort>(*r));
+  expectAbortOnWire(std::get<SdoAbort>(*r).abortCode, "normal download refused");
+  r = t.master->sdoTransact(SdoUploadSegmentRequest{false});  // no upload under way
+  ASSERT_TRUE(r && std::holds_alternative<SdoAbort>(*r));
+  expectAbortOnWire(0x05040001, "segment without a transfer");
 }
 
 TEST(CoeSdo, NotInThisStateAndPdoChangesOutsidePreOp) {

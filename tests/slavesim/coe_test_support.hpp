@@ -289,6 +289,13 @@ class MailboxMaster {
   std::vector<std::uint8_t> lastReply_;
 };
 
+// The low n bytes of v, little-endian (an SDO value).
+inline std::vector<std::uint8_t> bytesOf(std::uint32_t v, std::size_t n) {
+  std::vector<std::uint8_t> out(n);
+  for (std::size_t i = 0; i < n; ++i) out[i] = static_cast<std::uint8_t>(v >> (8 * i));
+  return out;
+}
+
 inline void requestState(topology::Segment& seg, std::uint16_t station, std::uint16_t control) {
   one(seg, Command::kFpwr, phys(station, reg::kAlControl.address), le16(control));
 }
