@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "protocol/frame.hpp"
+#include "protocol/sii.hpp"
 #include "topology/segment.hpp"
 
 namespace ecsim::testing {
@@ -43,6 +44,13 @@ inline std::vector<std::uint8_t> makeSii(std::uint32_t vendor, std::uint32_t pro
   w16(0x3E, 1);  // 2 kbit
   w16(0x3F, 1);
   w16(0x40, 0xFFFF);  // end category
+  if (mbxOutSize != 0) {
+    // A device with a mailbox has firmware: no device emulation (ESC configuration 0x0141
+    // bit 0 clear), so its state machine checks what the master configured (as
+    // config/sii_builder.cpp makes SII images for mailbox devices).
+    sii[1] = 0x00;
+    sii[sii::kWordChecksum * 2] = siiChecksum(ConstBytes(sii.data(), sii::kChecksumCoveredBytes));
+  }
   return sii;
 }
 
@@ -82,6 +90,7 @@ struct DatagramResult {
   std::uint32_t address;
   std::vector<std::uint8_t> data;
   std::uint16_t wkc;
+  std::uint16_t irq;  // the ORed ECAT event requests of the ESCs passed (0x0200/0x0210)
 };
 
 // Sends one frame with the given datagrams through the segment, runs the slaves' firmware
@@ -107,7 +116,8 @@ inline std::vector<DatagramResult> exchange(topology::Segment& seg,
   EXPECT_TRUE(frame.ok());
   for (auto d : *frame) {
     out.push_back({d.command(), d.adp(), d.ado(), d.address(),
-                   std::vector<std::uint8_t>(d.data().begin(), d.data().end()), d.wkc()});
+                   std::vector<std::uint8_t>(d.data().begin(), d.data().end()), d.wkc(),
+                   d.irq()});
   }
   return out;
 }
