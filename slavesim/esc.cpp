@@ -56,6 +56,7 @@ void Esc::reset() {
   writeLe16(memory_, reg::kSpeedCounterStart.address, 0x1000);
   memory_[reg::kSystemTimeDifferenceFilterDepth.address] = 0x04;
   memory_[reg::kSpeedCounterFilterDepth.address] = 0x0C;
+  resetEventState();  // DL control, ECAT event request, AL control mailbox (esc_events.cpp)
   loadFromSii();
 }
 
@@ -73,6 +74,7 @@ void Esc::processDatagram(DatagramView d, SimTime time) {
   lastWkcIncrement_ = 0;
   now_ = time;
   localNow_ = dc_.localTime(time);
+  orEventsIntoIrq(d);  // the header passes first (esc_events.cpp)
   if (!isKnownCommand(d.rawCommand())) return;  // unknown command: forwarded untouched
   const Command cmd = d.command();
   const std::uint16_t len = d.length();
@@ -138,6 +140,7 @@ void Esc::processDatagram(DatagramView d, SimTime time) {
         }
         inc = writeMemory(ado, d.data()) ? 1 : 0;
       }
+      if (ado < kRamStart) inc = ecatRegistersAccessed(ado, end, access.read, access.write, inc);
       break;
     }
   }

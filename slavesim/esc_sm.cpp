@@ -146,6 +146,10 @@ bool Esc::writeRam(std::uint16_t address, ConstBytes data, int smIndex) {
 void Esc::pdiSetAlStatus(std::uint16_t status, std::uint16_t code) {
   writeLe16(memory_, reg::kAlStatus.address, status);
   writeLe16(memory_, reg::kAlStatusCode.address, code);
+  // A PDI write of AL status is an AL status event for the master (0x0210 bit 3).
+  pdiWrite(reg::kEcatEventRequest,
+           static_cast<std::uint16_t>(read(reg::kEcatEventRequest) | reg::ecat_event::kAlStatus));
+  refreshEcatEvents();
 }
 
 namespace {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "protocol/al_status.hpp"
+#include "protocol/sii.hpp"
 #include "support/test_network.hpp"
 
 namespace ecsim::testing {
@@ -168,6 +169,83 @@ TEST_F(Esm, FirmwareErrorDropsToSafeOp) {
   seg_.slave(0).stateMachine().raiseError(seg_.slave(0).esc(), AlState::kSafeOp, 0x001B);
   EXPECT_EQ(status(), 0x0014);
   EXPECT_EQ(code(), 0x001B);
+}
+
+// Device emulation (ESC configuration 0x0141 bit 0, loaded from SII word 0; the EL2004
+// configuration area of makeSii has it): the ESC copies AL control into AL status as written,
+// error-acknowledge bit included, and checks nothing (ESC datasheet section II 0x0120 note).
+class DeviceEmulation : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    slavesim::SlaveProfile p;
+    p.processData = {{2, true, 2}};  // a firmware would want its outputs SM for SAFEOP
+    seg_.addSlave(makeSlave("io", 7, p));
+    one(seg_, Command::kApwr, phys(0, 0x0010), le16(0x1001));
+  }
+  std::uint32_t statusAndCode() {  // AL status (low word) and AL status code (high word)
+    const auto r = one(seg_, Command::kFprd, phys(0x1001, 0x0130), std::vector<std::uint8_t>(6));
+    return readLe16(r.data, 0) | (static_cast<std::uint32_t>(readLe16(r.data, 4)) << 16);
+  }
+  topology::Segment seg_;
+};
+
+TEST_F(DeviceEmulation, AlControlCopiedAsWrittenErrorAcknowledgeIncluded) {
+  ASSERT_TRUE(seg_.slave(0).esc().deviceEmulation());
+  // replay-dc.pcapng frame 4 (BWR 0x0120 = 0x0011) and frame 96 (AL status 0x0011): a real
+  // EK1100 shows INIT with the error bit, its acknowledge copied; soem-sdinfo frames 5/133.
+  one(seg_, Command::kBwr, phys(0, 0x0120), le16(0x0011));
+  EXPECT_EQ(statusAndCode(), 0x0011u);
+  // soem-sdinfo-ek1100-el1004.pcapng frame 197 (FPWR 0x0012) and frame 291 (0x0012).
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0120), le16(0x0012));
+  EXPECT_EQ(statusAndCode(), 0x0012u);
+  // Frames 445/479: SAFEOP as written; replay-dc.pcapng frames 3064/3070: OP.
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0120), le16(0x0004));
+  EXPECT_EQ(statusAndCode(), 0x0004u);
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0120), le16(0x0008));
+  EXPECT_EQ(statusAndCode(), 0x0008u);
+}
+
+TEST_F(DeviceEmulation, NoStateChecks) {
+  // INIT -> OP directly, without SyncManagers, as simple IO terminals allow.
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0120), le16(0x0008));
+  EXPECT_EQ(statusAndCode(), 0x0008u) << "a firmware would refuse with 0x0011 (INIT + error)";
+}
+
+// Without device emulation AL control behaves like a mailbox: once written by ECAT it cannot
+// be written again until the PDI has read it, and the PDI read clears AL event request 0x0220
+// bit 0 (section II 0x0120 note). The firmware runs between frames, so two writes in one frame
+// meet a full "mailbox". The datasheet does not say whether the refused write counts; as for a
+// full SyncManager mailbox, it gets no working counter.
+class AlControlMailbox : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    auto sii = makeSii(0xABCD, 7);
+    sii[1] = 0x00;  // ESC configuration: no device emulation
+    sii[sii::kWordChecksum * 2] = siiChecksum(ConstBytes(sii.data(), sii::kChecksumCoveredBytes));
+    seg_.addSlave(makeSlave("fw", 7, {}, sii));
+    one(seg_, Command::kApwr, phys(0, 0x0010), le16(0x1001));
+  }
+  topology::Segment seg_;
+};
+
+TEST_F(AlControlMailbox, SecondWriteBeforeTheFirmwareReadIsRefused) {
+  ASSERT_FALSE(seg_.slave(0).esc().deviceEmulation());
+  const auto r = exchange(seg_, {{Command::kFpwr, phys(0x1001, 0x0120), le16(0x0001)},
+                                 {Command::kFpwr, phys(0x1001, 0x0120), le16(0x0002)},
+                                 {Command::kFprd, phys(0x1001, 0x0120), {0, 0}}});
+  EXPECT_EQ(r[0].wkc, 1);
+  EXPECT_EQ(r[1].wkc, 0) << "AL control still unread by the firmware";
+  EXPECT_EQ(readLe16(r[2].data, 0), 0x0001);
+  // The firmware has read it after the frame: the master can write again.
+  EXPECT_EQ(one(seg_, Command::kFpwr, phys(0x1001, 0x0120), le16(0x0001)).wkc, 1);
+}
+
+TEST_F(AlControlMailbox, FirmwareReadClearsTheAlEventRequest) {
+  const auto r = exchange(seg_, {{Command::kFpwr, phys(0x1001, 0x0120), le16(0x0001)},
+                                 {Command::kFprd, phys(0x1001, 0x0220), {0, 0, 0, 0}}});
+  EXPECT_EQ(readLe32(r[1].data, 0) & 0x01u, 0x01u) << "AL control event pending";
+  const auto after = one(seg_, Command::kFprd, phys(0x1001, 0x0220), {0, 0, 0, 0});
+  EXPECT_EQ(readLe32(after.data, 0) & 0x01u, 0x00u) << "cleared by the firmware's PDI read";
 }
 
 }  // namespace
