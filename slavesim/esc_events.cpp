@@ -23,10 +23,8 @@ namespace ecsim::slavesim {
 using namespace esc_detail;
 
 void Esc::resetEventState() {
+  // Reset values of DL control and 0x0210 are the table's (esc_register_table.cpp).
   alControlUnread_ = false;  // "After reset, AL control can be written by ECAT" (0x0120 note)
-  alControlAccepted_ = read(reg::kAlControl);
-  pdiWrite(reg::kDlControl, reg::dl_control::kResetValue);
-  pdiWrite(reg::kEcatEventRequest, reg::ecat_event::kResetValue);
   smEventMask_ = 0;
   refreshEcatEvents();
 }
@@ -87,39 +85,14 @@ void Esc::refreshEcatEvents() {
   ecatIrq_ = static_cast<std::uint16_t>(request & read(reg::kEcatEventMask));
 }
 
-std::uint16_t Esc::ecatRegistersAccessed(std::uint32_t begin, std::uint32_t end, bool readAccess,
-                                         bool writeAccess, std::uint16_t wkc) {
-  bool changed = false;
-  if (readAccess) {
-    std::uint16_t request = read(reg::kEcatEventRequest);
-    if (overlaps(begin, end, reg::kDlStatus.address, reg::kDlStatus.width)) {
-      request = static_cast<std::uint16_t>(request & ~reg::ecat_event::kDlStatus);
-    }
-    if (overlaps(begin, end, reg::kAlStatus.address, reg::kAlStatus.width)) {
-      request = static_cast<std::uint16_t>(request & ~reg::ecat_event::kAlStatus);
-    }
-    changed = request != read(reg::kEcatEventRequest);
-    if (changed) pdiWrite(reg::kEcatEventRequest, request);
-  }
-  if (writeAccess && overlaps(begin, end, reg::kEcatEventMask.address, reg::kEcatEventMask.width)) {
-    smEventMask_ = static_cast<std::uint16_t>(read(reg::kEcatEventMask) & reg::ecat_event::kSmBits);
-    changed = true;
-  }
-  if (writeAccess && overlaps(begin, end, reg::kAlControl.address, reg::kAlControl.width)) {
-    if (ecatAlControlWritable()) {
-      alControlAccepted_ = read(reg::kAlControl);
-      ecatAlControlWritten();
-    } else {
-      // Refused: AL control keeps the unread value. A datagram that wrote nothing but AL
-      // control gets no working counter for its write (as a full SyncManager mailbox).
-      pdiWrite(reg::kAlControl, alControlAccepted_);
-      if (begin >= reg::kAlControl.address && end <= reg::kAlControl.end() && wkc != 0) {
-        wkc = static_cast<std::uint16_t>(wkc - (readAccess ? 2 : 1));
-      }
-    }
-  }
-  if (changed) refreshEcatEvents();
-  return wkc;
+void Esc::ecatEventMaskWritten() {
+  smEventMask_ = static_cast<std::uint16_t>(read(reg::kEcatEventMask) & reg::ecat_event::kSmBits);
+  refreshEcatEvents();
+}
+
+void Esc::clearEcatEvents(std::uint16_t bits) {
+  pdiWrite(reg::kEcatEventRequest, static_cast<std::uint16_t>(read(reg::kEcatEventRequest) & ~bits));
+  refreshEcatEvents();
 }
 
 }  // namespace ecsim::slavesim
