@@ -5,7 +5,6 @@
 #include <gtest/gtest.h>
 
 #include "protocol/al_status.hpp"
-#include "protocol/sii.hpp"
 #include "support/test_network.hpp"
 
 namespace ecsim::testing {
@@ -219,10 +218,7 @@ TEST_F(DeviceEmulation, NoStateChecks) {
 class AlControlMailbox : public ::testing::Test {
  protected:
   void SetUp() override {
-    auto sii = makeSii(0xABCD, 7);
-    sii[1] = 0x00;  // ESC configuration: no device emulation
-    sii[sii::kWordChecksum * 2] = siiChecksum(ConstBytes(sii.data(), sii::kChecksumCoveredBytes));
-    seg_.addSlave(makeSlave("fw", 7, {}, sii));
+    seg_.addSlave(makeSlave("fw", 7, {}, withoutDeviceEmulation(makeSii(0xABCD, 7))));
     one(seg_, Command::kApwr, phys(0, 0x0010), le16(0x1001));
   }
   topology::Segment seg_;

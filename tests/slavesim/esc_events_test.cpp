@@ -6,28 +6,10 @@
 // datagram still carries it); from frame 203 on the IRQ is 0x0000.
 #include <gtest/gtest.h>
 
-#include "protocol/sii.hpp"
 #include "support/test_network.hpp"
 
 namespace ecsim::testing {
 namespace {
-
-// A slave with firmware (ESC configuration 0x0141 = 0: no device emulation) and a mailbox.
-std::vector<std::uint8_t> firmwareSii() {
-  auto sii = makeSii(0xABCD, 7, 0x1000, 128, 0x1080, 128);
-  sii[1] = 0x00;
-  sii[sii::kWordChecksum * 2] = siiChecksum(ConstBytes(sii.data(), sii::kChecksumCoveredBytes));
-  return sii;
-}
-
-std::vector<std::uint8_t> smBytes(std::uint16_t start, std::uint16_t length, std::uint8_t control) {
-  std::vector<std::uint8_t> s(8, 0);
-  writeLe16(s, 0, start);
-  writeLe16(s, 2, length);
-  s[4] = control;
-  s[6] = 1;
-  return s;
-}
 
 TEST(EcatEvents, DlStatusEventUntilEachSlaveIsReadAsInTheSoemCapture) {
   topology::Segment seg;
@@ -72,7 +54,7 @@ class EcatAlEvents : public ::testing::Test {
   void SetUp() override {
     slavesim::SlaveProfile p;
     p.mailbox = slavesim::SlaveProfile::Mailbox{0x1000, 128, 0x1080, 128};
-    seg_.addSlave(makeSlave("fw", 7, p, firmwareSii()));
+    seg_.addSlave(makeSlave("fw", 7, p, makeSii(0xABCD, 7, 0x1000, 128, 0x1080, 128)));
     one(seg_, Command::kApwr, phys(0, 0x0010), le16(0x1001));
   }
   topology::Segment seg_;
@@ -80,8 +62,8 @@ class EcatAlEvents : public ::testing::Test {
 
 TEST_F(EcatAlEvents, AlStatusEventSetByTheFirmwareClearedByReadingAlStatus) {
   one(seg_, Command::kFpwr, phys(0x1001, 0x0200), le16(0x0008));
-  one(seg_, Command::kFpwr, phys(0x1001, 0x0800), smBytes(0x1000, 128, 0x26));
-  one(seg_, Command::kFpwr, phys(0x1001, 0x0808), smBytes(0x1080, 128, 0x22));
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0800), smChannelBytes(0x1000, 128, 0x26));
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0808), smChannelBytes(0x1080, 128, 0x22));
   EXPECT_EQ(one(seg_, Command::kBrd, phys(0, 0x0000), {0}).irq, 0x0000);
   one(seg_, Command::kFpwr, phys(0x1001, 0x0120), le16(0x0002));  // the firmware goes to PREOP
   EXPECT_EQ(one(seg_, Command::kBrd, phys(0, 0x0000), {0}).irq, 0x0008);
@@ -93,8 +75,8 @@ TEST_F(EcatAlEvents, AlStatusEventSetByTheFirmwareClearedByReadingAlStatus) {
 
 TEST_F(EcatAlEvents, MailboxSmEventWhileAResponseWaits) {
   // SM1 with "interrupt in ECAT event request" (control bit 4); mask bit 4 + 1.
-  one(seg_, Command::kFpwr, phys(0x1001, 0x0800), smBytes(0x1000, 128, 0x26));
-  one(seg_, Command::kFpwr, phys(0x1001, 0x0808), smBytes(0x1080, 128, 0x32));
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0800), smChannelBytes(0x1000, 128, 0x26));
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0808), smChannelBytes(0x1080, 128, 0x32));
   one(seg_, Command::kFpwr, phys(0x1001, 0x0200), le16(0x0020));
   EXPECT_EQ(one(seg_, Command::kBrd, phys(0, 0x0000), {0}).irq, 0x0000);
   const std::vector<std::uint8_t> response(16, 0x5A);

@@ -90,10 +90,10 @@ class TimeUnits : public ::testing::Test {
   void toSafeOp(SimTime t = 0) {
     wr(0x0800, smBytes(0x1000, 128, 0x26), t);
     wr(0x0808, smBytes(0x1080, 128, 0x22), t);
-    request(0x0012, t);
+    request(0x0002, t);  // no acknowledge bit: device emulation would copy it into AL status
     wr(0x0810, smBytes(0x1100, 2, 0x64), t);  // outputs, 3-buffer, watchdog trigger on
     wr(0x0818, smBytes(0x1180, 4, 0x20), t);
-    request(0x0014, t);
+    request(0x0004, t);
   }
   void toOp(SimTime t = 0) {
     toSafeOp(t);

@@ -51,8 +51,10 @@ TEST(LoopControl, OpenWithLinkBehavesAsAuto) {
 
 TEST(LoopControl, ClosedPort0ReceivesNothing) {
   topology::Segment seg;
-  buildLine(seg, 2);
-  one(seg, Command::kApwr, phys(0xFFFF, 0x0101), {0x03});  // second slave: port 0 closed
+  buildLine(seg, 3);
+  // The middle slave: port 0 closed while its port 1 is open (so section I §3.7 does not
+  // reopen port 0).
+  one(seg, Command::kApwr, phys(0xFFFF, 0x0101), {0x03});
   EXPECT_EQ(brd(seg, 0), -1) << "the frame is not received at slave 1's closed port 0";
 }
 
