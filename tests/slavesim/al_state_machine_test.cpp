@@ -10,15 +10,6 @@
 namespace ecsim::testing {
 namespace {
 
-std::vector<std::uint8_t> smBytes(std::uint16_t start, std::uint16_t length, std::uint8_t control) {
-  std::vector<std::uint8_t> s(8, 0);
-  writeLe16(s, 0, start);
-  writeLe16(s, 2, length);
-  s[4] = control;
-  s[6] = 1;
-  return s;
-}
-
 class Esm : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -38,12 +29,12 @@ class Esm : public ::testing::Test {
     return readLe16(one(seg_, Command::kFprd, phys(0x1001, 0x0134), {0, 0}).data, 0);
   }
   void configureMailbox() {
-    one(seg_, Command::kFpwr, phys(0x1001, 0x0800), smBytes(0x1000, 128, 0x26));
-    one(seg_, Command::kFpwr, phys(0x1001, 0x0808), smBytes(0x1080, 128, 0x22));
+    one(seg_, Command::kFpwr, phys(0x1001, 0x0800), smChannelBytes(0x1000, 128, 0x26));
+    one(seg_, Command::kFpwr, phys(0x1001, 0x0808), smChannelBytes(0x1080, 128, 0x22));
   }
   void configureProcessData(std::uint16_t outLen = 2, std::uint16_t inLen = 4) {
-    one(seg_, Command::kFpwr, phys(0x1001, 0x0810), smBytes(0x1100, outLen, 0x64));
-    one(seg_, Command::kFpwr, phys(0x1001, 0x0818), smBytes(0x1180, inLen, 0x20));
+    one(seg_, Command::kFpwr, phys(0x1001, 0x0810), smChannelBytes(0x1100, outLen, 0x64));
+    one(seg_, Command::kFpwr, phys(0x1001, 0x0818), smChannelBytes(0x1180, inLen, 0x20));
   }
   topology::Segment seg_;
 };
@@ -63,8 +54,8 @@ TEST_F(Esm, InitToPreOpNeedsTheMailboxConfigured) {
 }
 
 TEST_F(Esm, MailboxAtWrongAddressRefused) {
-  one(seg_, Command::kFpwr, phys(0x1001, 0x0800), smBytes(0x1200, 128, 0x26));
-  one(seg_, Command::kFpwr, phys(0x1001, 0x0808), smBytes(0x1080, 128, 0x22));
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0800), smChannelBytes(0x1200, 128, 0x26));
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0808), smChannelBytes(0x1080, 128, 0x22));
   request(0x0002);
   EXPECT_EQ(code(), 0x0016);
 }
