@@ -129,7 +129,16 @@ bool StateChangeTask::step(SimTime now) {
       bool pending = false;
       for (std::size_t position : reading_) {
         SlaveInfo& slave = slaves_[position];
-        if (slave.alError()) {
+        if (slave.alError() && slave.state() == target_ && slave.alStatusCode == 0) {
+          // Device emulation (ESC datasheet section II 0x0120): the ESC copies AL control into
+          // AL status as written, so an acknowledge bit sent with the request comes back as
+          // the error flag (a real EL1004: soem-sdinfo-ek1100-el1004.pcapng frames 289/293).
+          // The state is reached; writing it once more without the bit clears the flag.
+          acks_.add().fpwr(slave.station, reg::kAlControl.address,
+                           alControl(static_cast<std::uint16_t>(target_)));
+          outcome_[position] = Outcome::kReached;
+          slave.alStatus = static_cast<std::uint16_t>(slave.alStatus & ~kAlErrorFlag);
+        } else if (slave.alError()) {
           StateRefusal r;
           r.position = position;
           r.station = slave.station;

@@ -254,6 +254,40 @@ constexpr std::uint16_t communication(unsigned port) {
 }
 }  // namespace dl_status
 
+namespace dl_control {  // 0x0100-0x0103 (ESC datasheet section II, ESC DL Control)
+inline constexpr std::uint32_t kForwardingRule = 0x00000001;  // 1: destroy non-EtherCAT frames
+inline constexpr std::uint32_t kTemporaryLoop = 0x00000002;   // loop setting for about 1 s only
+inline constexpr std::uint32_t kRxFifoSizeShift = 16;         // bits 16-18
+// Reset value: forwarding rule set, RX FIFO size 7 (section II; the XMC4800's ESC SVD agrees).
+inline constexpr std::uint32_t kResetValue = 0x00000001 | (7u << kRxFifoSizeShift);
+// Loop control, 2 bits per port in byte 0x0101 (section I §3.1).
+inline constexpr std::uint8_t kLoopMask = 0x03;
+inline constexpr std::uint8_t kLoopAuto = 0x00;
+inline constexpr std::uint8_t kLoopAutoClose = 0x01;
+inline constexpr std::uint8_t kLoopOpen = 0x02;    // open whatever the link: no link loses frames
+inline constexpr std::uint8_t kLoopClosed = 0x03;  // closed whatever the link: nothing received
+constexpr std::uint8_t loopSetting(std::uint8_t loopByte, unsigned port) {
+  return static_cast<std::uint8_t>((loopByte >> (2 * port)) & kLoopMask);
+}
+}  // namespace dl_control
+
+namespace ecat_event {  // 0x0200 ECAT event mask / 0x0210 ECAT event request (section II)
+inline constexpr std::uint16_t kDcLatch = 0x0001;   // latch status 0x09AE/0x09AF shows an event
+inline constexpr std::uint16_t kDlStatus = 0x0004;  // DL status changed; ECAT read of 0x0110 clears
+inline constexpr std::uint16_t kAlStatus = 0x0008;  // AL status changed; ECAT read of 0x0130 clears
+inline constexpr unsigned kSmShift = 4;             // bit 4 + n: SyncManager n event
+inline constexpr unsigned kMaxSmEvents = 12;        // bits 4-15
+inline constexpr std::uint16_t kSmBits = 0xFFF0;
+// Reset value: DL status event pending (the ports' link state is new after reset; seen in
+// soem-sdinfo-ek1100-el1004.pcapng, where IRQ 0x0004 is set from the first frame after the
+// mask write, frame 15, until the master reads 0x0110 of the last slave, frame 201).
+inline constexpr std::uint16_t kResetValue = kDlStatus;
+}  // namespace ecat_event
+
+namespace al_event {  // 0x0220 AL event request (section II)
+inline constexpr std::uint32_t kAlControl = 0x00000001;  // AL control written; PDI read clears
+}  // namespace al_event
+
 namespace al {  // 0x0120 / 0x0130
 inline constexpr std::uint16_t kStateMask = 0x000F;
 inline constexpr std::uint16_t kErrorFlag = 0x0010;  // status: error indication; control: ack

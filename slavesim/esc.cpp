@@ -50,6 +50,7 @@ void Esc::reset() {
     ports = static_cast<std::uint8_t>(ports | (3u << (2 * p)));
   memory_[reg::kPortDescriptor.address] = ports;
   writeLe16(memory_, reg::kEscFeatures.address, type_.features);
+  resetEventState();  // AL control mailbox, ECAT event state (esc_events.cpp)
   loadFromSii();
 }
 
@@ -67,6 +68,7 @@ void Esc::processDatagram(DatagramView d, SimTime time) {
   lastWkcIncrement_ = 0;
   now_ = time;
   localNow_ = dc_.localTime(time);
+  orEventsIntoIrq(d);  // the header passes first (esc_events.cpp)
   if (!isKnownCommand(d.rawCommand())) return;  // unknown command: forwarded untouched
   const Command cmd = d.command();
   const std::uint16_t len = d.length();
@@ -129,6 +131,7 @@ void Esc::processDatagram(DatagramView d, SimTime time) {
       } else if (access.write) {
         inc = writeMemory(ado, d.data()) ? 1 : 0;
       }
+      if (access.read && ado < kRamStart) afterRegisterRead(ado, end);  // clear-on-read
       break;
     }
   }

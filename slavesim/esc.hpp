@@ -225,6 +225,25 @@ class Esc {
   // the first pulse waits for the 64-bit system time to reach it again (never, in practice).
   bool syncStartMissed() const { return sync_.running && sync_.startMissed; }
 
+  // ---- AL control, device emulation, ECAT events (esc_events.cpp; issue #15 items 2, 5) ----
+  // The firmware reads AL control through the PDI: clears AL event request 0x0220 bit 0 and
+  // lets the master write AL control again (section II 0x0120 note: without device emulation
+  // AL control behaves like a mailbox).
+  std::uint16_t pdiReadAlControl();
+  // False while an ECAT write of AL control would be refused: device emulation off and the
+  // firmware has not read the last value yet (section II 0x0120 note).
+  bool ecatAlControlWritable() const { return deviceEmulation() || !alControlUnread_; }
+  // The ECAT side wrote AL control (called after the write): AL event request, and with device
+  // emulation the copy into AL status as written, error-acknowledge bit included.
+  void ecatAlControlWritten();
+  // The DL status (0x0110) got a new value from the ports (topology): DL status event.
+  void dlStatusChanged();
+  // ECAT event request 0x0210 masked by the ECAT event mask 0x0200: what this ESC ORs into
+  // the IRQ field of every datagram passing it (section II 0x0200/0x0210).
+  std::uint16_t ecatIrq() const { return ecatIrq_; }
+  // Recomputes 0x0210 (SyncManager and latch bits follow their status registers) and ecatIrq.
+  void refreshEcatEvents();
+
   const EscCounters& counters() const { return counters_; }
 
  private:
@@ -364,6 +383,22 @@ class Esc {
   std::uint8_t activeFmmuCount_{0};
   std::vector<std::uint8_t> scratch_;  // read-write and bit-FMMU staging, one datagram
   std::uint16_t lastWkcIncrement_{0};
+
+  // ---- AL control, device emulation, ECAT events (esc_events.cpp) ----
+  void resetEventState();
+  // Register hooks (esc_registers.cpp calls them from the table's rows).
+  void ecatEventMaskWritten();
+  void clearEcatEvents(std::uint16_t bits);
+  // After a physical ECAT read of registers [begin, end): clear-on-read effects (ReadHook).
+  void afterRegisterRead(std::uint32_t begin, std::uint32_t end);
+  // The header of a datagram passes: the masked event request goes into its IRQ field.
+  void orEventsIntoIrq(DatagramView d) {
+    if (smEventMask_ != 0) refreshEcatEvents();  // SM events follow SM status between frames
+    if (ecatIrq_ != 0) d.setIrq(static_cast<std::uint16_t>(d.irq() | ecatIrq_));
+  }
+  bool alControlUnread_{false};   // written by ECAT, not yet read by the PDI
+  std::uint16_t ecatIrq_{0};      // 0x0210 & 0x0200
+  std::uint16_t smEventMask_{0};  // SM bits of 0x0200 (nonzero: SM events are followed)
 };
 
 }  // namespace ecsim::slavesim

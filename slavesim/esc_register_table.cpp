@@ -37,12 +37,14 @@ std::vector<RegisterRow> buildRows() {
       row(kEscResetEcat, kAll, kNone),
       row(kEscResetPdi, kNone, kAll),
       // Data link layer
-      row(kDlControl, kAll, kNone, 0, WriteHook::kDlControl),
+      row(kDlControl, kAll, kNone, dl_control::kResetValue, WriteHook::kDlControl),
       row(kPhysicalRwOffset, kAll, kNone),
-      row(kDlStatus, kNone, kNone),
+      row(kDlStatus, kNone, kNone, 0, WriteHook::kNone, ByteRule::kStore,
+          ReadHook::kDlStatusEvent),
       // Application layer: AL control is the master's, AL status the firmware's.
-      row(kAlControl, kAll, kNone, 0x0001, WriteHook::kAlControl),
-      row(kAlStatus, kNone, kAll, 0x0001),
+      row(kAlControl, kAll, kNone, 0x0001, WriteHook::kAlControl, ByteRule::kAlControlMailbox),
+      row(kAlStatus, kNone, kAll, 0x0001, WriteHook::kNone, ByteRule::kStore,
+          ReadHook::kAlStatusEvent),
       row(kAlStatusCode, kNone, kAll),
       row(kRunLedOverride, kAll, kNone),
       row(kErrLedOverride, kAll, kNone),
@@ -52,9 +54,10 @@ std::vector<RegisterRow> buildRows() {
       row(kPdiInformation, kNone, kNone),
       block(kPdiConfiguration.address, 4, kNone, kNone, "PDI Configuration"),
       // Interrupts
-      row(kEcatEventMask, kAll, kNone),
+      row(kEcatEventMask, kAll, kNone, 0, WriteHook::kEcatEventMask),
       row(kPdiAlEventMask, kNone, kAll),
-      row(kEcatEventRequest, kNone, kNone),
+      row(kEcatEventRequest, kNone, kNone, ecat_event::kResetValue, WriteHook::kNone,
+          ByteRule::kStore, ReadHook::kEcatEventRequest),
       row(kAlEventRequest, kNone, kNone),
       // Error counters (section II 0x0300-0x0313): cleared by a write of any value.
       block(kErrorCountersBegin, 0x0C, kAll, kNone, "RX Error Counters", WriteHook::kNone,

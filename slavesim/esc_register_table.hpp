@@ -27,6 +27,8 @@ enum class ByteRule : std::uint8_t {
   kClearLostLink,  // a write to any byte of 0x0310-0x0313 clears all four
   kNoStore,        // the write has an effect (hook), the content does not change (0x0900)
   kSmLocked,       // SM channel bytes 0-4: writable only while the SM is disabled (section II)
+  kAlControlMailbox,  // 0x0120: without device emulation refused (no WKC) until the PDI read
+                      // the last value (section II 0x0120 note; Esc::ecatAlControlWritable)
 };
 
 // Side effects of an ECAT write, run once per access after all bytes are stored, in this order.
@@ -34,7 +36,9 @@ enum class WriteHook : std::uint8_t {
   kNone,
   kReceiveTimeLatch,   // 0x0900: latch the port receive times of this frame (section I §9.1.2)
   kDlControl,          // 0x0100-0x0103: port loop settings may change
-  kAlControl,          // 0x0120: the firmware sees an AL control event (0x0220 bit 0)
+  kAlControl,          // 0x0120: AL control event 0x0220 bit 0; device emulation copies it
+                       // into AL status (esc_events.cpp)
+  kEcatEventMask,      // 0x0200: which ECAT events go into the datagrams' IRQ field
   kSiiCommand,         // 0x0503: execute the EEPROM command (section II 0x0502)
   kSystemTime,         // 0x0910-0x0917: one step of the drift control loop, 0x092C
   kSpeedCounterStart,  // 0x0930: reset of the drift control loop
@@ -49,6 +53,10 @@ enum class ReadHook : std::uint8_t {
   kNone,
   kSystemTime,  // 0x0910: the local copy of the system time at this instant
   kSyncUnit,    // 0x0980-0x09A7: cyclic unit status and next pulse times (esc_time_units.cpp)
+  kEcatEventRequest,  // 0x0210: SyncManager and latch bits follow their status (esc_events.cpp)
+  // Clear-on-read, after the read (Esc::afterRegisterRead): the ECAT event bit of the register.
+  kDlStatusEvent,  // 0x0110: clears 0x0210 bit 2
+  kAlStatusEvent,  // 0x0130: clears 0x0210 bit 3
   kCount
 };
 

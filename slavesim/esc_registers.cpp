@@ -76,10 +76,14 @@ bool Esc::writeRegisters(std::uint16_t address, ConstBytes data) {
     const std::uint32_t a = begin + i;
     const std::uint8_t mask = regs_.ecatWriteMask[a];
     if (mask == 0) continue;
+    // AL control still unread by the firmware: refused, no working counter for it (as a full
+    // SyncManager mailbox; section II 0x0120 note does not say).
+    if (regs_.rule[a] == ByteRule::kAlControlMailbox && !ecatAlControlWritable()) continue;
     accepted = true;
     hooks |= 1u << static_cast<unsigned>(regs_.write[a]);
     switch (regs_.rule[a]) {
       case ByteRule::kStore:
+      case ByteRule::kAlControlMailbox:
         memory_[a] = static_cast<std::uint8_t>((memory_[a] & ~mask) | (data[i] & mask));
         break;
       case ByteRule::kClearOnWrite:
@@ -127,8 +131,10 @@ void Esc::runWriteHook(WriteHook hook, std::uint32_t begin, std::uint32_t end, C
       events_.dlControlWritten = true;
       break;
     case WriteHook::kAlControl:
-      events_.alControlWritten = true;
-      memory_[reg::kAlEventRequest.address] |= 0x01;
+      ecatAlControlWritten();  // esc_events.cpp
+      break;
+    case WriteHook::kEcatEventMask:
+      ecatEventMaskWritten();  // esc_events.cpp
       break;
     case WriteHook::kSiiCommand:
       // The command byte was written: execute it (write needs the enable bit in the same access).
@@ -176,10 +182,25 @@ void Esc::refreshVolatile(std::uint16_t begin, std::uint16_t end) {
   if ((hooks & (1u << static_cast<unsigned>(ReadHook::kSyncUnit))) != 0) {
     refreshSyncRegisters(begin, end);
   }
+  if ((hooks & (1u << static_cast<unsigned>(ReadHook::kEcatEventRequest))) != 0) {
+    refreshEcatEvents();
+  }
   if ((hooks & (1u << static_cast<unsigned>(ReadHook::kSystemTime))) != 0) {
     writeLe64(memory_, reg::kSystemTime.address,
               static_cast<std::uint64_t>(wrapAdd(localNow_, read(reg::kSystemTimeOffset))));
   }
+}
+
+void Esc::afterRegisterRead(std::uint32_t begin, std::uint32_t end) {
+  const std::uint32_t hooks = readHooks(begin, end);
+  std::uint16_t clear = 0;
+  if ((hooks & (1u << static_cast<unsigned>(ReadHook::kDlStatusEvent))) != 0) {
+    clear |= reg::ecat_event::kDlStatus;
+  }
+  if ((hooks & (1u << static_cast<unsigned>(ReadHook::kAlStatusEvent))) != 0) {
+    clear |= reg::ecat_event::kAlStatus;
+  }
+  if (clear != 0) clearEcatEvents(clear);  // esc_events.cpp
 }
 
 bool Esc::pdiWriteRegisters(std::uint16_t address, ConstBytes data) {

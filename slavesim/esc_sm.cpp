@@ -150,6 +150,10 @@ void Esc::pdiSetAlStatus(std::uint16_t status, std::uint16_t code) {
                                       static_cast<std::uint8_t>(code >> 8)};
   pdiWriteRegisters(reg::kAlStatus.address, s);
   pdiWriteRegisters(reg::kAlStatusCode.address, c);
+  // A PDI write of AL status is an AL status event for the master (0x0210 bit 3).
+  pdiWrite(reg::kEcatEventRequest,
+           static_cast<std::uint16_t>(read(reg::kEcatEventRequest) | reg::ecat_event::kAlStatus));
+  refreshEcatEvents();
 }
 
 namespace {

@@ -27,8 +27,15 @@ void Slave::poll(SimTime now) {
     if (device_) device_->powerUp();
   }
   if (events.alControlWritten) {
-    if (device_) device_->updateProfile(profile_);
-    esm_.onAlControl(esc_, profile_);
+    // The firmware reads AL control through the PDI, which frees it for the master's next
+    // write (section II 0x0120 note). With device emulation the ESC has already copied it
+    // into AL status: no firmware state machine, no checks (a real EK1100 or EL1004 goes from
+    // INIT to OP as told: soem-sdinfo-ek1100-el1004.pcapng frames 197/291, 449/479).
+    (void)esc_.pdiReadAlControl();
+    if (!esc_.deviceEmulation()) {
+      if (device_) device_->updateProfile(profile_);
+      esm_.onAlControl(esc_, profile_);
+    }
   }
   if (events.mailboxReceived && mailbox_) {
     std::size_t n = esc_.pdiMailboxReceive(mailboxBuffer_);

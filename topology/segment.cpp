@@ -9,8 +9,9 @@ namespace {
 // Frame processing order (datasheet section I §3.2 Table 10): 0 -> 3 -> 1 -> 2 -> 0.
 constexpr std::array<std::uint8_t, kPortCount> kNextPort{3, 2, 0, 1};
 
-constexpr std::uint8_t kDlLoopMask = 0x03;  // per port in DL control byte 1 (0x0101)
-constexpr std::uint8_t kDlLoopAlwaysClosed = 0x03;
+// DL control 0x0100 bit 1: the loop setting holds for "about 1 second", then the previous one
+// is back (ESC datasheet section II, ESC DL Control).
+constexpr SimTime kTemporaryLoopNs = kNsPerSecond;
 
 }  // namespace
 
@@ -25,6 +26,9 @@ std::size_t Segment::addSlave(std::unique_ptr<slavesim::Slave> slave) {
   arrival_.push_back({});
   arrivalMask_.push_back(0);
   openMask_.push_back(0);
+  lostMask_.push_back(0);
+  loopPermanent_.push_back(0);
+  loopRevertAt_.push_back(kNoRevert);
   observers_.push_back({});
   stack_.reserve(slaves_.size() + 1);
   escs_.push_back(&slaves_.back()->esc());
@@ -104,12 +108,24 @@ void Segment::setDelays(std::size_t slave, SimTime processing, SimTime forwardin
   routeValid_ = false;
 }
 
-bool Segment::portOpen(std::size_t s, unsigned p) const {
+bool Segment::portLink(std::size_t s, unsigned p) const {
+  if (s == 0 && p == 0) return linkUp_[0][0];  // the master's cable
   const PortLink& l = links_[s][p];
-  if (l.slave == kNoSlave || !linkUp_[s][p]) return false;
-  if (!linkUp_[static_cast<std::size_t>(l.slave)][l.port]) return false;
-  const std::uint8_t loop = slaves_[s]->esc().reg8(reg::kDlControl.address + 1);
-  return ((loop >> (2 * p)) & kDlLoopMask) != kDlLoopAlwaysClosed;
+  return l.slave != kNoSlave && linkUp_[s][p] &&
+         linkUp_[static_cast<std::size_t>(l.slave)][l.port];
+}
+
+bool Segment::portOpen(std::size_t s, unsigned p) const {
+  // Loop control 0x0101 (section I §3.1): auto (and auto close, modelled as auto) follow the
+  // link; "open" is open whatever the link (frames sent into no link are lost), "closed" is
+  // closed whatever the link (frames arriving there are not received). A port the ESC does
+  // not have is closed.
+  const auto& esc = slaves_[s]->esc();
+  if (p >= esc.type().maxPorts) return false;
+  const std::uint8_t loop = reg::dl_control::loopSetting(
+      static_cast<std::uint8_t>(esc.read(reg::kDlControl) >> 8), p);
+  if (loop == reg::dl_control::kLoopClosed) return false;
+  return loop == reg::dl_control::kLoopOpen || portLink(s, p);
 }
 
 void Segment::setLinkUp(std::size_t s, unsigned p, bool up) {
@@ -130,29 +146,64 @@ void Segment::refreshLinkStatus() {
 void Segment::refreshLinkStatus(std::size_t s) {
   routeValid_ = false;  // port states may have changed
   auto& esc = slaves_[s]->esc();
-  std::uint16_t dl = static_cast<std::uint16_t>(esc.reg16(reg::kDlStatus.address) & 0x000F);
+  std::uint8_t open = 0;
   for (unsigned p = 0; p < kPortCount; ++p) {
-    bool link = (s == 0 && p == 0)
-                    ? linkUp_[0][0]
-                    : (links_[s][p].slave != kNoSlave && linkUp_[s][p] &&
-                       linkUp_[static_cast<std::size_t>(links_[s][p].slave)][links_[s][p].port]);
-    bool open = (s == 0 && p == 0) ? link : portOpen(s, p);
+    if (portOpen(s, p)) open = static_cast<std::uint8_t>(open | (1u << p));
+  }
+  // Port 0 is open when every other port is closed, whatever its own setting (section I §3.7).
+  const std::uint8_t all = static_cast<std::uint8_t>((1u << esc.type().maxPorts) - 1);
+  if ((open & all & ~1u) == 0 && portLink(s, 0)) open = static_cast<std::uint8_t>(open | 1u);
+  const auto before = esc.read(reg::kDlStatus);
+  auto dl = static_cast<std::uint16_t>(before & 0x000F);
+  std::uint8_t lost = 0;
+  for (unsigned p = 0; p < kPortCount; ++p) {
+    const bool link = portLink(s, p);
+    const bool isOpen = (open & (1u << p)) != 0;
     if (link) dl |= reg::dl_status::physicalLink(p);
-    if (!open) dl |= reg::dl_status::loopPort(p);
-    if (open) dl |= reg::dl_status::communication(p);
+    if (!isOpen) dl |= reg::dl_status::loopPort(p);
+    if (isOpen && link) dl |= reg::dl_status::communication(p);
+    if (isOpen && !link) lost = static_cast<std::uint8_t>(lost | (1u << p));
   }
-  esc.pdiWrite16(reg::kDlStatus.address, dl);
-  std::uint8_t mask = 0;
-  for (unsigned p = 0; p < kPortCount; ++p) {
-    if (portOpen(s, p)) mask = static_cast<std::uint8_t>(mask | (1u << p));
+  esc.pdiWrite(reg::kDlStatus, dl);
+  if (dl != before) esc.dlStatusChanged();  // ECAT event 0x0210 bit 2
+  openMask_[s] = open;
+  lostMask_[s] = lost;
+}
+
+void Segment::noteDlControlWrite(std::size_t s, SimTime now) {
+  const auto dl = slaves_[s]->esc().read(reg::kDlControl);
+  if ((dl & reg::dl_control::kTemporaryLoop) == 0) {
+    loopPermanent_[s] = static_cast<std::uint8_t>(dl >> 8);
+    loopRevertAt_[s] = kNoRevert;
+    return;
   }
-  openMask_[s] = mask;
+  loopRevertAt_[s] = now + kTemporaryLoopNs;
+  nextLoopRevert_ = std::min(nextLoopRevert_, loopRevertAt_[s]);
+}
+
+void Segment::revertTemporaryLoops(SimTime now) {
+  nextLoopRevert_ = kNoRevert;
+  for (std::size_t s = 0; s < slaves_.size(); ++s) {
+    if (loopRevertAt_[s] == kNoRevert) continue;
+    if (now < loopRevertAt_[s]) {
+      nextLoopRevert_ = std::min(nextLoopRevert_, loopRevertAt_[s]);
+      continue;
+    }
+    auto& esc = slaves_[s]->esc();
+    const auto dl = esc.read(reg::kDlControl);
+    esc.pdiWrite(reg::kDlControl,
+                 (dl & ~0x0000FF00u) | (static_cast<std::uint32_t>(loopPermanent_[s]) << 8));
+    loopRevertAt_[s] = kNoRevert;
+    refreshLinkStatus(s);
+  }
 }
 
 FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
   FrameOutcome outcome;
+  if (sendTime >= nextLoopRevert_) revertTemporaryLoops(sendTime);
   auto parsed = EtherCatFrame::parse(frame);
-  if (!parsed.ok() || slaves_.empty() || !linkUp_[0][0]) {
+  // Nothing is received at slave 0 without the master's link or with its port 0 closed.
+  if (!parsed.ok() || slaves_.empty() || !linkUp_[0][0] || (openMask_[0] & 1u) == 0) {
     if (!parsed.ok()) ++counters_.framesMalformed;
     return outcome;
   }
@@ -207,6 +258,7 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
   notify(0, 0, frame, sendTime, true);
   SimTime t = sendTime + cableDelay(masterCable_);
   bool bad = false;  // corrupted on the way (fault injection): counted, never executed
+  bool lost = false;  // lost at a port by its loop setting (never returns to the master)
   if (faults_ != nullptr) arriveWithFaults(0, 0, t, bad);
   stack_.push_back({0, 0, 0});
   arrival_[0][0] = t;
@@ -236,6 +288,10 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
     }
     const SimTime tOut = t + delays_[s][viaEpu ? 0 : 1];
     viaEpu = false;
+    if (!upstream && (lostMask_[s] & (1u << out)) != 0) {
+      lost = true;  // forced open without a link: the frame goes nowhere (section I §3.1)
+      break;
+    }
     if (upstream) {
       const std::uint8_t entry = top.entryPort;
       stack_.pop_back();
@@ -261,13 +317,17 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
       t = tOut + cableNs_[s][k];  // the cable just crossed (both ends hold its delay)
     }
     if (faults_ != nullptr) arriveWithFaults(s, k, t, bad);
+    if ((openMask_[s] & (1u << k)) == 0) {
+      lost = true;  // arrived at a closed port: not received (section I §3.1, loop "closed")
+      break;
+    }
     arrival_[s][k] = t;
     arrivalMask_[s] = static_cast<std::uint8_t>(arrivalMask_[s] | (1u << k));
   }
   for (const std::uint32_t i : latched_) {
     escs_[i]->completeReceiveTimeLatch(arrival_[i], arrivalMask_[i]);
   }
-  if (record) {
+  if (record && !lost) {
     for (std::size_t i = 0; i < slaves_.size(); ++i) {
       for (unsigned p = 0; p < kPortCount; ++p) routeArrival_[i][p] = arrival_[i][p] - sendTime;
     }
@@ -277,7 +337,7 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
   }
   // The master has the frame when its last bit is in: wire footprint of the frame itself
   // (preamble + SFD + frame + FCS).
-  outcome.delivered = !bad;
+  outcome.delivered = !bad && !lost;
   outcome.returnTime = sendTime + outcome.firstBitRoundTrip + frameTime;
   return outcome;
 }
@@ -297,12 +357,17 @@ bool Segment::arriveWithFaults(std::size_t s, unsigned port, SimTime& t, bool& b
 }
 
 void Segment::pollSlaves(SimTime now) {
+  if (now >= nextLoopRevert_) revertTemporaryLoops(now);
   bool dlChanged = false;
-  for (auto& slave : slaves_) {
-    dlChanged |= slave->esc().hasEvents() && slave->esc().peekEvents().dlControlWritten;
-    if (slave->esc().hasEvents() || slave->device() != nullptr ||
-        slave->mailboxServer() != nullptr) {
-      slave->poll(now);
+  for (std::size_t i = 0; i < slaves_.size(); ++i) {
+    auto& slave = *slaves_[i];
+    if (slave.esc().hasEvents() && slave.esc().peekEvents().dlControlWritten) {
+      dlChanged = true;
+      noteDlControlWrite(i, now);
+    }
+    if (slave.esc().hasEvents() || slave.device() != nullptr ||
+        slave.mailboxServer() != nullptr) {
+      slave.poll(now);
     }
   }
   if (dlChanged) refreshLinkStatus();

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -131,6 +132,17 @@ class Segment {
 
  private:
   bool portOpen(std::size_t slave, unsigned port) const;
+  bool portLink(std::size_t slave, unsigned port) const;
+  // Loop control (issue #15 item 6): a DL control write seen after a frame at time `now`
+  // (bit 1 set: the loop setting is temporary and reverts kTemporaryLoopNs later), and the
+  // revert of temporary settings that are due.
+  void noteDlControlWrite(std::size_t slave, SimTime now);
+  void revertTemporaryLoops(SimTime now);
+  static constexpr SimTime kNoRevert = std::numeric_limits<SimTime>::max();
+  std::vector<std::uint8_t> lostMask_;       // open ports without a link: frames are lost there
+  std::vector<std::uint8_t> loopPermanent_;  // last loop byte written without bit 1
+  std::vector<SimTime> loopRevertAt_;        // kNoRevert, or when the temporary setting ends
+  SimTime nextLoopRevert_{kNoRevert};
   SimTime cableDelay(double metres) const {
     return static_cast<SimTime>(metres * timing_.cableNsPerMetre + 0.5);
   }

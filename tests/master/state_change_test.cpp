@@ -81,8 +81,13 @@ TEST_F(StateChangeTest, RefusingSlaveIsReportedWithCodeAndTextAndAcknowledged) {
 }
 
 TEST_F(StateChangeTest, IllegalJumpIsRefusedByEverySlave) {
+  // Slaves with firmware (ESC configuration 0x0141 bit 0 clear): their state machine checks
+  // the transition. With device emulation (the generic slave, like a real EK1100) the ESC
+  // copies the request into AL status unchecked (ESC datasheet section II 0x0120).
   for (int i = 0; i < 2; ++i) {
-    net_.segment().addSlave(slavesim::makeGenericSlave("G" + std::to_string(i), 0));
+    SiiContents c = ioSii("F" + std::to_string(i), 0x42, 0, 0);
+    c.config.pdiControl = static_cast<std::uint16_t>(c.config.pdiControl & 0x00FF);
+    net_.segment().addSlave(makeSiiSlave("F" + std::to_string(i), c));
   }
   net_.segment().wireLine();
   scan();

@@ -10,15 +10,6 @@
 namespace ecsim::testing {
 namespace {
 
-std::vector<std::uint8_t> smBytes(std::uint16_t start, std::uint16_t length, std::uint8_t control) {
-  std::vector<std::uint8_t> s(8, 0);
-  writeLe16(s, 0, start);
-  writeLe16(s, 2, length);
-  s[4] = control;
-  s[6] = 1;
-  return s;
-}
-
 class Esm : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -38,12 +29,12 @@ class Esm : public ::testing::Test {
     return readLe16(one(seg_, Command::kFprd, phys(0x1001, 0x0134), {0, 0}).data, 0);
   }
   void configureMailbox() {
-    one(seg_, Command::kFpwr, phys(0x1001, 0x0800), smBytes(0x1000, 128, 0x26));
-    one(seg_, Command::kFpwr, phys(0x1001, 0x0808), smBytes(0x1080, 128, 0x22));
+    one(seg_, Command::kFpwr, phys(0x1001, 0x0800), smChannelBytes(0x1000, 128, 0x26));
+    one(seg_, Command::kFpwr, phys(0x1001, 0x0808), smChannelBytes(0x1080, 128, 0x22));
   }
   void configureProcessData(std::uint16_t outLen = 2, std::uint16_t inLen = 4) {
-    one(seg_, Command::kFpwr, phys(0x1001, 0x0810), smBytes(0x1100, outLen, 0x64));
-    one(seg_, Command::kFpwr, phys(0x1001, 0x0818), smBytes(0x1180, inLen, 0x20));
+    one(seg_, Command::kFpwr, phys(0x1001, 0x0810), smChannelBytes(0x1100, outLen, 0x64));
+    one(seg_, Command::kFpwr, phys(0x1001, 0x0818), smChannelBytes(0x1180, inLen, 0x20));
   }
   topology::Segment seg_;
 };
@@ -63,8 +54,8 @@ TEST_F(Esm, InitToPreOpNeedsTheMailboxConfigured) {
 }
 
 TEST_F(Esm, MailboxAtWrongAddressRefused) {
-  one(seg_, Command::kFpwr, phys(0x1001, 0x0800), smBytes(0x1200, 128, 0x26));
-  one(seg_, Command::kFpwr, phys(0x1001, 0x0808), smBytes(0x1080, 128, 0x22));
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0800), smChannelBytes(0x1200, 128, 0x26));
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0808), smChannelBytes(0x1080, 128, 0x22));
   request(0x0002);
   EXPECT_EQ(code(), 0x0016);
 }
@@ -168,6 +159,80 @@ TEST_F(Esm, FirmwareErrorDropsToSafeOp) {
   seg_.slave(0).stateMachine().raiseError(seg_.slave(0).esc(), AlState::kSafeOp, 0x001B);
   EXPECT_EQ(status(), 0x0014);
   EXPECT_EQ(code(), 0x001B);
+}
+
+// Device emulation (ESC configuration 0x0141 bit 0, loaded from SII word 0; the EL2004
+// configuration area of makeSii has it): the ESC copies AL control into AL status as written,
+// error-acknowledge bit included, and checks nothing (ESC datasheet section II 0x0120 note).
+class DeviceEmulation : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    slavesim::SlaveProfile p;
+    p.processData = {{2, true, 2}};  // a firmware would want its outputs SM for SAFEOP
+    seg_.addSlave(makeSlave("io", 7, p));
+    one(seg_, Command::kApwr, phys(0, 0x0010), le16(0x1001));
+  }
+  std::uint32_t statusAndCode() {  // AL status (low word) and AL status code (high word)
+    const auto r = one(seg_, Command::kFprd, phys(0x1001, 0x0130), std::vector<std::uint8_t>(6));
+    return readLe16(r.data, 0) | (static_cast<std::uint32_t>(readLe16(r.data, 4)) << 16);
+  }
+  topology::Segment seg_;
+};
+
+TEST_F(DeviceEmulation, AlControlCopiedAsWrittenErrorAcknowledgeIncluded) {
+  ASSERT_TRUE(seg_.slave(0).esc().deviceEmulation());
+  // replay-dc.pcapng frame 4 (BWR 0x0120 = 0x0011) and frame 96 (AL status 0x0011): a real
+  // EK1100 shows INIT with the error bit, its acknowledge copied; soem-sdinfo frames 5/133.
+  one(seg_, Command::kBwr, phys(0, 0x0120), le16(0x0011));
+  EXPECT_EQ(statusAndCode(), 0x0011u);
+  // soem-sdinfo-ek1100-el1004.pcapng frame 197 (FPWR 0x0012) and frame 291 (0x0012).
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0120), le16(0x0012));
+  EXPECT_EQ(statusAndCode(), 0x0012u);
+  // Frames 445/479: SAFEOP as written; replay-dc.pcapng frames 3064/3070: OP.
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0120), le16(0x0004));
+  EXPECT_EQ(statusAndCode(), 0x0004u);
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0120), le16(0x0008));
+  EXPECT_EQ(statusAndCode(), 0x0008u);
+}
+
+TEST_F(DeviceEmulation, NoStateChecks) {
+  // INIT -> OP directly, without SyncManagers, as simple IO terminals allow.
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0120), le16(0x0008));
+  EXPECT_EQ(statusAndCode(), 0x0008u) << "a firmware would refuse with 0x0011 (INIT + error)";
+}
+
+// Without device emulation AL control behaves like a mailbox: once written by ECAT it cannot
+// be written again until the PDI has read it, and the PDI read clears AL event request 0x0220
+// bit 0 (section II 0x0120 note). The firmware runs between frames, so two writes in one frame
+// meet a full "mailbox". The datasheet does not say whether the refused write counts; as for a
+// full SyncManager mailbox, it gets no working counter.
+class AlControlMailbox : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    seg_.addSlave(makeSlave("fw", 7, {}, withoutDeviceEmulation(makeSii(0xABCD, 7))));
+    one(seg_, Command::kApwr, phys(0, 0x0010), le16(0x1001));
+  }
+  topology::Segment seg_;
+};
+
+TEST_F(AlControlMailbox, SecondWriteBeforeTheFirmwareReadIsRefused) {
+  ASSERT_FALSE(seg_.slave(0).esc().deviceEmulation());
+  const auto r = exchange(seg_, {{Command::kFpwr, phys(0x1001, 0x0120), le16(0x0001)},
+                                 {Command::kFpwr, phys(0x1001, 0x0120), le16(0x0002)},
+                                 {Command::kFprd, phys(0x1001, 0x0120), {0, 0}}});
+  EXPECT_EQ(r[0].wkc, 1);
+  EXPECT_EQ(r[1].wkc, 0) << "AL control still unread by the firmware";
+  EXPECT_EQ(readLe16(r[2].data, 0), 0x0001);
+  // The firmware has read it after the frame: the master can write again.
+  EXPECT_EQ(one(seg_, Command::kFpwr, phys(0x1001, 0x0120), le16(0x0001)).wkc, 1);
+}
+
+TEST_F(AlControlMailbox, FirmwareReadClearsTheAlEventRequest) {
+  const auto r = exchange(seg_, {{Command::kFpwr, phys(0x1001, 0x0120), le16(0x0001)},
+                                 {Command::kFprd, phys(0x1001, 0x0220), {0, 0, 0, 0}}});
+  EXPECT_EQ(readLe32(r[1].data, 0) & 0x01u, 0x01u) << "AL control event pending";
+  const auto after = one(seg_, Command::kFprd, phys(0x1001, 0x0220), {0, 0, 0, 0});
+  EXPECT_EQ(readLe32(after.data, 0) & 0x01u, 0x00u) << "cleared by the firmware's PDI read";
 }
 
 }  // namespace

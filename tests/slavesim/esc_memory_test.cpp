@@ -24,15 +24,6 @@ std::vector<std::uint8_t> fmmuBytes(std::uint32_t logical, std::uint16_t length,
   return f;
 }
 
-std::vector<std::uint8_t> smBytes(std::uint16_t start, std::uint16_t length, std::uint8_t control) {
-  std::vector<std::uint8_t> s(8, 0);
-  writeLe16(s, 0, start);
-  writeLe16(s, 2, length);
-  s[4] = control;
-  s[6] = 1;
-  return s;
-}
-
 class Memory : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -48,8 +39,8 @@ class Memory : public ::testing::Test {
 
 TEST_F(Memory, LrwByteAlignedOutputsAndInputs) {
   // Slave 1: outputs SM2 at 0x1100 (2 B) <- logical 0..1, inputs SM3 at 0x1180 (2 B) -> 2..3.
-  one(seg_, Command::kFpwr, phys(0x1001, 0x0810), smBytes(0x1100, 2, 0x64));
-  one(seg_, Command::kFpwr, phys(0x1001, 0x0818), smBytes(0x1180, 2, 0x20));
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0810), smChannelBytes(0x1100, 2, 0x64));
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0818), smChannelBytes(0x1180, 2, 0x20));
   one(seg_, Command::kFpwr, phys(0x1001, 0x0600), fmmuBytes(0, 2, 0, 7, 0x1100, 0, 2));
   one(seg_, Command::kFpwr, phys(0x1001, 0x0610), fmmuBytes(2, 2, 0, 7, 0x1180, 0, 1));
   std::vector<std::uint8_t> in{0x34, 0x12};
@@ -115,7 +106,7 @@ TEST_F(Memory, LogicalWithoutMatchingFmmuGetsNoWkc) {
 }
 
 TEST_F(Memory, MailboxWriteSetsFullAndRefusesASecondWrite) {
-  one(seg_, Command::kFpwr, phys(0x1001, 0x0800), smBytes(0x1000, 16, 0x26));
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0800), smChannelBytes(0x1000, 16, 0x26));
   std::vector<std::uint8_t> msg(16, 0x42);
   EXPECT_EQ(one(seg_, Command::kFpwr, phys(0x1001, 0x1000), msg).wkc, 1);
   EXPECT_EQ(esc(0).reg8(0x0805) & 0x08, 0x08) << "SM0 status: mailbox full";
@@ -128,8 +119,8 @@ TEST_F(Memory, MailboxWriteSetsFullAndRefusesASecondWrite) {
 }
 
 TEST_F(Memory, MailboxReadOnlyWhenFullAndLastByteEmptiesIt) {
-  one(seg_, Command::kFpwr, phys(0x1001, 0x0800), smBytes(0x1000, 16, 0x26));
-  one(seg_, Command::kFpwr, phys(0x1001, 0x0808), smBytes(0x1080, 16, 0x22));
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0800), smChannelBytes(0x1000, 16, 0x26));
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0808), smChannelBytes(0x1080, 16, 0x22));
   EXPECT_EQ(one(seg_, Command::kFprd, phys(0x1001, 0x1080), std::vector<std::uint8_t>(16)).wkc, 0)
       << "empty read mailbox: no WKC";
   std::vector<std::uint8_t> answer{1, 2, 3, 4};
@@ -146,7 +137,7 @@ TEST_F(Memory, MailboxReadOnlyWhenFullAndLastByteEmptiesIt) {
 }
 
 TEST_F(Memory, ThreeBufferGivesTheReaderOnlyCompleteBuffers) {
-  one(seg_, Command::kFpwr, phys(0x1001, 0x0810), smBytes(0x1100, 4, 0x64));
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0810), smChannelBytes(0x1100, 4, 0x64));
   one(seg_, Command::kFpwr, phys(0x1001, 0x1100), {1, 2, 3, 4});
   auto first = esc(0).pdiOutputs(2);
   EXPECT_EQ(std::vector<std::uint8_t>(first.begin(), first.end()),
@@ -163,7 +154,7 @@ TEST_F(Memory, ThreeBufferGivesTheReaderOnlyCompleteBuffers) {
 }
 
 TEST_F(Memory, ThreeBufferInputsReadTheNewestPdiBuffer) {
-  one(seg_, Command::kFpwr, phys(0x1001, 0x0818), smBytes(0x1180, 2, 0x20));
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0818), smChannelBytes(0x1180, 2, 0x20));
   esc(0).pdiWriteInputs(3, std::vector<std::uint8_t>{1, 1});
   esc(0).pdiWriteInputs(3, std::vector<std::uint8_t>{2, 2});
   esc(0).pdiWriteInputs(3, std::vector<std::uint8_t>{3, 3});
@@ -174,7 +165,7 @@ TEST_F(Memory, ThreeBufferInputsReadTheNewestPdiBuffer) {
 }
 
 TEST_F(Memory, SmRegistersLockedWhileEnabled) {
-  one(seg_, Command::kFpwr, phys(0x1001, 0x0810), smBytes(0x1100, 4, 0x64));
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0810), smChannelBytes(0x1100, 4, 0x64));
   one(seg_, Command::kFpwr, phys(0x1001, 0x0810), {0x00, 0x12, 0x08});
   EXPECT_EQ(esc(0).smConfig(2).start, 0x1100);
   EXPECT_EQ(esc(0).smConfig(2).length, 4);

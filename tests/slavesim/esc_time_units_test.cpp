@@ -18,15 +18,6 @@ namespace {
 constexpr SimTime kMs = kNsPerMs;
 constexpr std::uint16_t kStation = 0x1001;
 
-std::vector<std::uint8_t> smBytes(std::uint16_t start, std::uint16_t length, std::uint8_t control) {
-  std::vector<std::uint8_t> s(8, 0);
-  writeLe16(s, 0, start);
-  writeLe16(s, 2, length);
-  s[4] = control;
-  s[6] = 1;
-  return s;
-}
-
 std::vector<std::uint8_t> le32(std::uint32_t v) {
   std::vector<std::uint8_t> b(4);
   writeLe32(b, 0, v);
@@ -88,12 +79,12 @@ class TimeUnits : public ::testing::Test {
   std::uint16_t code(SimTime t = 0) { return readLe16(rd(0x0134, 2, t), 0); }
   void request(std::uint16_t control, SimTime t = 0) { wr(0x0120, le16(control), t); }
   void toSafeOp(SimTime t = 0) {
-    wr(0x0800, smBytes(0x1000, 128, 0x26), t);
-    wr(0x0808, smBytes(0x1080, 128, 0x22), t);
-    request(0x0012, t);
-    wr(0x0810, smBytes(0x1100, 2, 0x64), t);  // outputs, 3-buffer, watchdog trigger on
-    wr(0x0818, smBytes(0x1180, 4, 0x20), t);
-    request(0x0014, t);
+    wr(0x0800, smChannelBytes(0x1000, 128, 0x26), t);
+    wr(0x0808, smChannelBytes(0x1080, 128, 0x22), t);
+    request(0x0002, t);  // no acknowledge bit: device emulation would copy it into AL status
+    wr(0x0810, smChannelBytes(0x1100, 2, 0x64), t);  // outputs, 3-buffer, watchdog trigger on
+    wr(0x0818, smChannelBytes(0x1180, 4, 0x20), t);
+    request(0x0004, t);
   }
   void toOp(SimTime t = 0) {
     toSafeOp(t);

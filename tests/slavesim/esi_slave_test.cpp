@@ -93,7 +93,7 @@ Outcome driveLikeSoem(topology::Segment& seg) {
     one(seg, Command::kFpwr, phys(station, reg::smChannel(1)),
         smRegisterBytes(mbx.sendOffset, inSize, c1));
   }
-  requestState(seg, station, 0x0012);
+  requestState(seg, station, 0x0002);
   std::uint16_t status = alStatus(seg, station);
   if (status != 0x0002) {
     out.reason =

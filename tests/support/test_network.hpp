@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "protocol/frame.hpp"
+#include "protocol/sii.hpp"
 #include "topology/segment.hpp"
 
 namespace ecsim::testing {
@@ -21,6 +22,25 @@ namespace ecsim::testing {
 // 0xD8 in word 7. Used so synthetic test images carry a checksum a real ESC accepts.
 inline constexpr std::array<std::uint8_t, 16> kEl2004ConfigArea = {
     0x04, 0x01, 0x00, 0x00, 0x00, 0x00, 0x0f, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0xd8, 0x00};
+
+// The SII image with ESC configuration 0x0141 = 0 (no device emulation: a slave with firmware,
+// whose state machine checks the master's configuration) and its checksum fixed.
+inline std::vector<std::uint8_t> withoutDeviceEmulation(std::vector<std::uint8_t> sii) {
+  sii[1] = 0x00;
+  sii[sii::kWordChecksum * 2] = siiChecksum(ConstBytes(sii.data(), sii::kChecksumCoveredBytes));
+  return sii;
+}
+
+// The 8 register bytes of one SyncManager channel, enabled.
+inline std::vector<std::uint8_t> smChannelBytes(std::uint16_t start, std::uint16_t length,
+                                                std::uint8_t control) {
+  std::vector<std::uint8_t> s(8, 0);
+  writeLe16(s, 0, start);
+  writeLe16(s, 2, length);
+  s[4] = control;
+  s[6] = 1;
+  return s;
+}
 
 // A minimal SII image: EL2004 config area, the given identity, optional standard mailbox.
 inline std::vector<std::uint8_t> makeSii(std::uint32_t vendor, std::uint32_t product,
@@ -43,7 +63,8 @@ inline std::vector<std::uint8_t> makeSii(std::uint32_t vendor, std::uint32_t pro
   w16(0x3E, 1);  // 2 kbit
   w16(0x3F, 1);
   w16(0x40, 0xFFFF);  // end category
-  return sii;
+  // A device with a mailbox has firmware (as config/sii_builder.cpp makes SII images).
+  return mbxOutSize != 0 ? withoutDeviceEmulation(std::move(sii)) : sii;
 }
 
 inline std::unique_ptr<slavesim::Slave> makeSlave(std::string name, std::uint32_t product,
@@ -82,6 +103,7 @@ struct DatagramResult {
   std::uint32_t address;
   std::vector<std::uint8_t> data;
   std::uint16_t wkc;
+  std::uint16_t irq;  // the ORed ECAT event requests of the ESCs passed (0x0200/0x0210)
 };
 
 // Sends one frame with the given datagrams through the segment, runs the slaves' firmware
@@ -107,7 +129,8 @@ inline std::vector<DatagramResult> exchange(topology::Segment& seg,
   EXPECT_TRUE(frame.ok());
   for (auto d : *frame) {
     out.push_back({d.command(), d.adp(), d.ado(), d.address(),
-                   std::vector<std::uint8_t>(d.data().begin(), d.data().end()), d.wkc()});
+                   std::vector<std::uint8_t>(d.data().begin(), d.data().end()), d.wkc(),
+                   d.irq()});
   }
   return out;
 }

@@ -98,7 +98,7 @@ TEST(Replay, RealDcCaptureRunsToTheEndAgainstTheTerminalsSiiDumps) {
   }
   // What still differs is listed and explained in docs/fidelity.md; keep it from growing.
   EXPECT_EQ(report->wkcMismatches, 0u);
-  EXPECT_LE(report->dataMismatches, 609u);
+  EXPECT_LE(report->dataMismatches, 606u);  // 609 before device emulation (AL status)
 }
 
 }  // namespace
