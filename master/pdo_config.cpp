@@ -161,7 +161,11 @@ void PdoDiscoveryTask::readAssignment(std::size_t smPosition) {
                                                       ": " + pdo.error().context);
                return;
              }
-             result_.sms[smPosition].pdos[k].index = static_cast<std::uint16_t>(le(*pdo));
+             const auto pdoIndex = static_cast<std::uint16_t>(le(*pdo));
+             // A zero entry assigns nothing (dynamic-PDO devices leave unused subindexes 0):
+             // skipped, as other masters do; dropped from the list when discovery ends.
+             if (pdoIndex == 0) return;
+             result_.sms[smPosition].pdos[k].index = pdoIndex;
              readMapping(smPosition, k);
            });
     }
@@ -200,6 +204,9 @@ bool PdoDiscoveryTask::next(SimTime now) {
   if (!status_.ok() || reads_.empty()) {
     running_ = false;
     if (status_.ok()) {
+      for (auto& sm : result_.sms) {
+        std::erase_if(sm.pdos, [](const auto& pdo) { return pdo.index == 0; });
+      }
       result_.source = result_.sms.empty() ? PdoSource::kNone : PdoSource::kCoe;
       addSiiNames(slave_, result_);
     }

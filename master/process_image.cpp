@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "protocol/coe.hpp"
+
 namespace ecsim::master {
 namespace {
 
@@ -189,7 +191,7 @@ std::vector<ProcessVariable> processVariables(const ProcessImageLayout& layout) 
       std::uint32_t bit = (sm.logicalStart - layout.logicalBase) * 8;
       for (const auto& pdo : sm.pdos) {
         for (const auto& e : pdo.entries) {
-          if (e.index != 0) {
+          if (!isPaddingEntry(e.index)) {
             out.push_back(
                 {sl.position, sm.outputs, bit, e.bitLength, e.index, e.subindex, pdo.name, e.name});
           }

@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <map>
 
+#include "protocol/coe.hpp"
+
 namespace ecsim::master {
 namespace {
 
@@ -214,7 +216,7 @@ std::vector<VariableInfo> nameVariables(const ProcessImageLayout& layout,
       std::uint32_t bit = (sm.logicalStart - layout.logicalBase) * 8;
       for (const auto& pdo : sm.pdos) {
         for (const auto& e : pdo.entries) {
-          if (e.index != 0) {
+          if (!isPaddingEntry(e.index)) {
             VariableInfo v;
             v.slave = sl.position < names.size() ? names[sl.position]
                                                  : "Slave" + std::to_string(sl.position);

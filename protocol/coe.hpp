@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cstdint>
+#include <iterator>
 #include <string_view>
 #include <vector>
 
@@ -20,6 +21,18 @@
 #include "protocol/result.hpp"
 
 namespace ecsim {
+
+// The length in bits of a CiA 301 §7.4.8.3 dummy mapping entry: the index of a standard data
+// type 0x0001-0x0007 (BOOLEAN ... UNSIGNED32), subindex 0, maps no object but pads the PDO by
+// that type's length. 0 for any other index.
+constexpr std::uint8_t dummyEntryBits(std::uint16_t index) {
+  constexpr std::uint8_t kBits[] = {0, 1, 8, 16, 32, 8, 16, 32};
+  return index < std::size(kBits) ? kBits[index] : 0;
+}
+// A mapping entry that maps no object: a gap (index 0) or a dummy entry.
+constexpr bool isPaddingEntry(std::uint16_t index) {
+  return index == 0 || dummyEntryBits(index) != 0;
+}
 
 enum class CoeService : std::uint8_t {
   kEmergency = 1,

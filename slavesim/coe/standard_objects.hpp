@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "protocol/coe.hpp"
 #include "slavesim/coe/object_dictionary.hpp"
 
 namespace ecsim::slavesim::coe {
@@ -47,14 +48,6 @@ constexpr bool isPdoAssignIndex(std::uint16_t index) {
   return index >= kPdoAssignBase && index < kPdoAssignBase + 32;
 }
 
-// The length in bits of a CiA 301 §7.4.8.3 dummy mapping entry: the index of a standard data
-// type 0x0001-0x0007 (BOOLEAN ... UNSIGNED32), subindex 0, maps no object but pads the PDO by
-// that type's length. 0 for any other index.
-constexpr std::uint8_t dummyEntryBits(std::uint16_t index) {
-  constexpr std::uint8_t kBits[] = {0, 1, 8, 16, 32, 8, 16, 32};
-  return index < std::size(kBits) ? kBits[index] : 0;
-}
-
 // A PDO mapping entry value: index << 16 | subindex << 8 | bit length.
 struct MappedObject {
   std::uint16_t index{0};  // 0: a gap of bitLength bits
@@ -62,7 +55,7 @@ struct MappedObject {
   std::uint8_t bitLength{0};
 
   // Padding rather than an object: a gap (index 0) or a dummy entry (dummyEntryBits).
-  constexpr bool isPadding() const { return index == 0 || dummyEntryBits(index) != 0; }
+  constexpr bool isPadding() const { return isPaddingEntry(index); }
 
   static constexpr MappedObject fromRaw(std::uint32_t raw) {
     return {static_cast<std::uint16_t>(raw >> 16), static_cast<std::uint8_t>(raw >> 8),

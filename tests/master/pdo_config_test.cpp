@@ -105,5 +105,32 @@ TEST_F(PdoConfigTest, DictionaryWithoutSmTypesGivesNothing) {
   EXPECT_EQ(task.uploads(), 1u);  // 0x1C00:00 aborted, nothing more asked
 }
 
+
+TEST_F(PdoConfigTest, ZeroAssignmentEntriesAndDummyMappingEntriesAreNotObjects) {
+  // A dynamic-PDO device leaves unused assignment subindexes 0 (0x1C12:02 = 0 with sub 0 = 2:
+  // ETG.1020 / as TwinCAT and IgH skip it), and a mapping may pad with a CiA 301 §7.4.8.3 dummy
+  // entry (0x0005:00, 8 bits = UNSIGNED8). Neither is an object the master may ask for or list.
+  namespace coe = slavesim::coe;
+  auto od = std::make_shared<coe::ObjectDictionary>();
+  coe::addIdentityObject(*od, {kTestVendor, 0x53, 1, 0});
+  const std::uint8_t types[] = {1, 2, 3, 4};
+  coe::addSyncManagerTypes(*od, types);
+  od->addArray(0x7000, "Outputs", 0x0006, 16, 1,
+               coe::access::kReadWrite | coe::access::kRxMappable);
+  coe::PdoMappingSpec rx{0x1600, "Out", {{0x0005, 0, 8}, {0x7000, 1, 16}}, {}, 2, false};
+  coe::addPdoMapping(*od, rx);
+  const std::uint16_t rxPdos[] = {0x1600, 0x0000};
+  coe::addPdoAssignment(*od, 2, rxPdos, 2, true);
+  net_.segment().addSlave(makeCoeSlave("Dyn", 0x53, od));
+  bringUp();
+  auto data = discover(0);
+  ASSERT_EQ(data.sms.size(), 1u);
+  ASSERT_EQ(data.sms[0].pdos.size(), 1u) << "the zero entry is no PDO";
+  EXPECT_EQ(data.sms[0].pdos[0].index, 0x1600);
+  EXPECT_EQ(data.outputBits(), 24u) << "the dummy entry pads by 8 bits";
+  EXPECT_TRUE(isPaddingEntry(data.sms[0].pdos[0].entries[0].index));
+  EXPECT_FALSE(isPaddingEntry(data.sms[0].pdos[0].entries[1].index));
+}
+
 }  // namespace
 }  // namespace ecsim::testing
