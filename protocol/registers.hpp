@@ -140,6 +140,9 @@ inline constexpr Reg<std::uint8_t> kType{0xB, "Type"};
 inline constexpr Reg<std::uint8_t> kActivate{0xC, "Activate"};
 inline constexpr std::uint8_t kTypeRead = 0x01;   // ECAT read access (inputs)
 inline constexpr std::uint8_t kTypeWrite = 0x02;  // ECAT write access (outputs)
+inline constexpr std::uint8_t kActivateEnable = 0x01;
+inline constexpr std::uint8_t kBitMask = 0x07;  // start/stop bit registers: bits 2:0
+inline constexpr Block kReserved{0xD, 3, "Reserved"};
 }  // namespace fmmu
 constexpr std::uint16_t fmmuChannel(unsigned n) {
   return static_cast<std::uint16_t>(kFmmuBase + kFmmuSize * n);
