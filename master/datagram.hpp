@@ -8,10 +8,12 @@
 
 #include <cstdint>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "protocol/bytes.hpp"
 #include "protocol/frame.hpp"
+#include "protocol/registers.hpp"
 #include "protocol/result.hpp"
 #include "protocol/time.hpp"
 
@@ -50,6 +52,45 @@ class Datagram {
   void fpwr(std::uint16_t station, std::uint16_t ado, ConstBytes data) {
     prepare(Command::kFpwr, DatagramHeader::physical(station, ado), data, 1);
   }
+  // Typed register access (protocol/registers.hpp): the width comes from the register map,
+  // never from the caller. `adp` is what `command` addresses (station, -position, 0 for
+  // broadcast); expected WKC as for one slave unless given.
+  template <typename T>
+  void read(Command command, std::uint16_t adp, reg::Reg<T> r, std::uint16_t expectedWkc = 1) {
+    prepare(command, DatagramHeader::physical(adp, r.address), r.width, expectedWkc);
+  }
+  // One read from `first` through `last` (values then taken with get()).
+  template <typename T, typename U>
+  void read(Command command, std::uint16_t adp, reg::Reg<T> first, reg::Reg<U> last,
+            std::uint16_t expectedWkc = 1) {
+    prepare(command, DatagramHeader::physical(adp, first.address), reg::spanWidth(first, last),
+            expectedWkc);
+  }
+  template <typename T>
+  void write(Command command, std::uint16_t adp, reg::Reg<T> r, std::type_identity_t<T> value,
+             std::uint16_t expectedWkc = 1) {
+    prepare(command, DatagramHeader::physical(adp, r.address), r.width, expectedWkc);
+    reg::putIn(r, data(), r.address, value);
+  }
+  template <typename T>
+  void fprd(std::uint16_t station, reg::Reg<T> r) {
+    read(Command::kFprd, station, r);
+  }
+  template <typename T, typename U>
+  void fprd(std::uint16_t station, reg::Reg<T> first, reg::Reg<U> last) {
+    read(Command::kFprd, station, first, last);
+  }
+  template <typename T>
+  void fpwr(std::uint16_t station, reg::Reg<T> r, std::type_identity_t<T> value) {
+    write(Command::kFpwr, station, r, value);
+  }
+  // Register r in what came back; the datagram must have read it (its ADO through its end).
+  template <typename T>
+  T get(reg::Reg<T> r) const {
+    if (r.address < ado() || r.end() > ado() + length_) return T{};  // not read: a caller's bug
+    return reg::valueIn(r, data(), ado());
+  }
+
   // Auto-increment address of the slave at `position` (0 = first): ADP = -position.
   static std::uint16_t autoIncrement(std::size_t position) {
     return static_cast<std::uint16_t>(0x10000 - (position & 0xFFFF));

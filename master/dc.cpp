@@ -9,17 +9,9 @@
 namespace ecsim::master {
 namespace {
 
-constexpr std::uint16_t kPortTimes = reg::kReceiveTimePort0.address;
-constexpr std::uint16_t kSystemTime = reg::kSystemTime.address;
-constexpr std::uint16_t kEpuTime = reg::kReceiveTimeEcatProcessingUnit.address;
-constexpr std::uint16_t kOffset = reg::kSystemTimeOffset.address;
-constexpr std::uint16_t kDelay = reg::kSystemTimeDelay.address;
-constexpr std::uint16_t kDifference = reg::kSystemTimeDifference.address;
-constexpr std::uint16_t kSpeedCounterStart = reg::kSpeedCounterStart.address;
-constexpr std::uint16_t kAssign = reg::kCyclicUnitControl.address;
-constexpr std::uint16_t kActivation = reg::kDcActivation.address;
-constexpr std::uint16_t kSync0Start = reg::kStartTimeCyclicOperation.address;
-constexpr std::uint16_t kSync0CycleTime = reg::kSync0CycleTime.address;
+// ESI AssignActivate: one word over 0x0980 (cyclic unit control) and 0x0981 (activation).
+constexpr std::uint16_t kAssignActivateLength =
+    reg::spanWidth(reg::kCyclicUnitControl, reg::kDcActivation);
 constexpr std::array<unsigned, 4> kPortOrder{0, 3, 1, 2};
 
 bool portOpen(const SlaveInfo& s, unsigned port) {
@@ -154,46 +146,41 @@ void DcInitTask::enter(Phase phase, SimTime now) {
     case Phase::kLatch:
       masterTime_ = options_.masterTime.value_or(static_cast<std::uint64_t>(now));
       // Every slave counts (DC or not); the count is not checked.
-      batch_.add().prepare(Command::kBwr, DatagramHeader::physical(0, kPortTimes), std::uint16_t{4},
-                           0);
+      batch_.add().write(Command::kBwr, 0, reg::kReceiveTimePort0, 0, 0);
       break;
     case Phase::kRead:
       for (const auto& s : slaves_) {
         if (!setup_.dc[s.position]) continue;
-        batch_.add().fprd(s.station, kPortTimes, 16);
-        batch_.add().fprd(s.station, kEpuTime, 8);
+        batch_.add().fprd(s.station, reg::kReceiveTimePort0, reg::kReceiveTimePort3);
+        batch_.add().fprd(s.station, reg::kReceiveTimeEcatProcessingUnit);
       }
       break;
     case Phase::kWrite:
       for (const auto& s : slaves_) {
         if (!setup_.dc[s.position]) continue;
-        batch_.add().fpwr(s.station, kOffset, leBytes(setup_.offsets[s.position], 8));
-        batch_.add().fpwr(s.station, kDelay,
-                          leBytes(static_cast<std::uint64_t>(setup_.delays[s.position]), 4));
+        batch_.add().fpwr(s.station, reg::kSystemTimeOffset, setup_.offsets[s.position]);
+        batch_.add().fpwr(s.station, reg::kSystemTimeDelay,
+                          static_cast<std::uint32_t>(setup_.delays[s.position]));
       }
-      {
-        // Restart the drift filters (speed counter start 0x1000, datasheet section II).
-        Datagram& reset = batch_.add();
-        reset.prepare(Command::kBwr, DatagramHeader::physical(0, kSpeedCounterStart),
-                      ConstBytes(leBytes(0x1000, 2).data(), 2), 0);
-      }
+      // Restart the drift filters (speed counter start 0x1000, datasheet section II).
+      batch_.add().write(Command::kBwr, 0, reg::kSpeedCounterStart, 0x1000, 0);
       break;
     case Phase::kDrift:
-      batch_.add().prepare(Command::kFrmw, DatagramHeader::physical(reference, kSystemTime),
-                           std::uint16_t{8}, 0);
+      batch_.add().read(Command::kFrmw, reference, reg::kSystemTime, 0);
       ++driftSent_;
       break;
     case Phase::kSync0Time:
-      batch_.add().fprd(reference, kSystemTime, 8);
+      batch_.add().fprd(reference, reg::kSystemTime);
       break;
     case Phase::kSync0:
       for (std::size_t position : setup_.sync0) {
         const std::uint16_t station = slaves_[position].station;
-        batch_.add().fpwr(station, kActivation, leBytes(0, 1));
-        batch_.add().fpwr(station, kSync0CycleTime,
-                          leBytes(static_cast<std::uint64_t>(setup_.sync0Cycle), 4));
-        batch_.add().fpwr(station, kSync0Start, leBytes(setup_.sync0Start, 8));
-        batch_.add().fpwr(station, kAssign, leBytes(assignActivate_[position], 2));
+        batch_.add().fpwr(station, reg::kDcActivation, 0);
+        batch_.add().fpwr(station, reg::kSync0CycleTime,
+                          static_cast<std::uint32_t>(setup_.sync0Cycle));
+        batch_.add().fpwr(station, reg::kStartTimeCyclicOperation, setup_.sync0Start);
+        batch_.add().fpwr(station, reg::kCyclicUnitControl.address,
+                          leBytes(assignActivate_[position], kAssignActivateLength));
       }
       break;
     case Phase::kDone:
@@ -225,8 +212,10 @@ bool DcInitTask::step(SimTime now) {
       std::size_t d = 0;
       for (const auto& s : slaves_) {
         if (!setup_.dc[s.position]) continue;
-        for (unsigned p = 0; p < 4; ++p) times[s.position][p] = readLe32(batch_[d].data(), 4 * p);
-        epu[s.position] = readLe64(batch_[d + 1].data(), 0);
+        for (unsigned p = 0; p < 4; ++p) {
+          times[s.position][p] = batch_[d].get(reg::kReceiveTimePorts[p]);
+        }
+        epu[s.position] = batch_[d + 1].get(reg::kReceiveTimeEcatProcessingUnit);
         d += 2;
       }
       const std::vector<SimTime> absolute = computeDcDelays(slaves_, times);
@@ -259,7 +248,7 @@ bool DcInitTask::step(SimTime now) {
       enter(Phase::kSync0Time, now);
       return true;
     case Phase::kSync0Time: {
-      const std::uint64_t t = readLe64(batch_[0].data(), 0);
+      const std::uint64_t t = batch_[0].get(reg::kSystemTime);
       const auto cycle = static_cast<std::uint64_t>(cycleTime_);
       const std::uint64_t ahead = t + static_cast<std::uint64_t>(options_.sync0StartDelay);
       setup_.sync0Cycle = cycleTime_;
@@ -281,7 +270,7 @@ void addDcSyncErrorReads(DatagramBatch& batch, const std::vector<SlaveInfo>& sla
   for (const auto& s : slaves) {
     if (s.position >= setup.dc.size() || !setup.dc[s.position]) continue;
     if (setup.reference && s.position == *setup.reference) continue;
-    batch.add().fprd(s.station, kDifference, 4);
+    batch.add().fprd(s.station, reg::kSystemTimeDifference);
   }
 }
 
@@ -289,7 +278,7 @@ Result<SimTime> dcSyncErrorFrom(const DatagramBatch& batch) {
   ECSIM_TRY(batch.check());
   SimTime worst = 0;
   for (std::size_t i = 0; i < batch.size(); ++i) {
-    const std::uint32_t raw = readLe32(batch[i].data(), 0);
+    const std::uint32_t raw = batch[i].get(reg::kSystemTimeDifference);
     worst = std::max<SimTime>(worst, static_cast<SimTime>(raw & 0x7FFFFFFFu));  // sign-magnitude
   }
   return worst;

@@ -153,7 +153,7 @@ EniConfig eniFromMaster(const Master& master) {
         esm.type = sm.outputs ? "Outputs" : "Inputs";
         esm.startAddress = sm.setting.start;
         esm.length = sm.setting.length;
-        esm.control = sm.setting.control;
+        esm.control = sm.setting.control.encode();
         esm.enable = sm.setting.length > 0;
         for (const PdoInfo& pdo : sm.pdos) {
           esm.pdos.push_back(pdo.index);

@@ -28,12 +28,8 @@ Status Master::applyEniSetup() {
   for (std::size_t i = 0; i < slaves_.size() && i < eni.slaves.size(); ++i) {
     const EniSlave& want = eni.slaves[i];
     if (slaves_[i].station != want.physAddr) {
-      std::uint8_t raw[2];
-      writeLe16(Bytes(raw, 2), 0, want.physAddr);
-      batch.add().prepare(Command::kApwr,
-                          DatagramHeader::physical(Datagram::autoIncrement(i),
-                                                   reg::kConfiguredStationAddress.address),
-                          ConstBytes(raw, 2), 1);
+      batch.add().write(Command::kApwr, Datagram::autoIncrement(i),
+                        reg::kConfiguredStationAddress, want.physAddr);
     }
     if (want.mailbox && slaves_[i].mailbox) {
       MailboxConfig& m = *slaves_[i].mailbox;

@@ -5,9 +5,6 @@
 namespace ecsim::master {
 namespace {
 
-constexpr std::uint16_t kAlStatusLength =
-    static_cast<std::uint16_t>(reg::kAlStatusCode.end() - reg::kAlStatus.address);
-
 // Where a recovery starts for a slave that answers at its station address.
 SlaveRecoveryTask::Stage firstStage(const SlaveInfo& slave) {
   switch (slave.state().value_or(AlState::kInit)) {
@@ -87,11 +84,9 @@ HealthMonitor::HealthMonitor(Transport& transport, std::vector<SlaveInfo>& slave
   }
   // The status reads and probes are made once, so that queueing them never allocates.
   for (std::size_t i = 0; i < slaves.size(); ++i) {
-    reads_.add().fprd(slaves[i].station, reg::kAlStatus.address, kAlStatusLength);
-    probes_.add().prepare(Command::kAprd,
-                          DatagramHeader::physical(Datagram::autoIncrement(i),
-                                                   reg::kConfiguredStationAddress.address),
-                          2, 1);
+    reads_.add().fprd(slaves[i].station, reg::kAlStatus, reg::kAlStatusCode);
+    probes_.add().read(Command::kAprd, Datagram::autoIncrement(i),
+                       reg::kConfiguredStationAddress);
   }
   readPositions_.reserve(slaves.size());
   probed_.reserve(slaves.size());
@@ -173,16 +168,13 @@ void HealthMonitor::queueStatusReads() {
     const Watch& w = slaves_[i];
     if (w.recovery) continue;
     Datagram& read = reads_[readPositions_.size()];
-    read.fprd(slaveInfos_[i].station, reg::kAlStatus.address, kAlStatusLength);
+    read.fprd(slaveInfos_[i].station, reg::kAlStatus, reg::kAlStatusCode);
     transport_.queue(read);
     readPositions_.push_back(i);
     if (w.health.condition == SlaveCondition::kLost ||
         w.health.condition == SlaveCondition::kFailed) {
       Datagram& probe = probes_[probed_.size()];
-      probe.prepare(Command::kAprd,
-                    DatagramHeader::physical(Datagram::autoIncrement(i),
-                                             reg::kConfiguredStationAddress.address),
-                    2, 1);
+      probe.read(Command::kAprd, Datagram::autoIncrement(i), reg::kConfiguredStationAddress);
       transport_.queue(probe);
       probed_.push_back(i);
     }
@@ -200,8 +192,8 @@ void HealthMonitor::takeStatusReads(std::uint64_t cycle, SimTime now) {
     const Datagram& d = reads_[k];
     if (w.recovery) continue;  // started meanwhile (by a probe)
     if (d.wkcOk()) {
-      info.alStatus = readLe16(d.data(), 0);
-      info.alStatusCode = readLe16(d.data(), reg::kAlStatusCode.address - reg::kAlStatus.address);
+      info.alStatus = d.get(reg::kAlStatus);
+      info.alStatusCode = d.get(reg::kAlStatusCode);
       w.health.alStatus = info.alStatus;
       w.health.alStatusCode = info.alStatusCode;
       w.misses = 0;
@@ -265,7 +257,7 @@ void HealthMonitor::takeProbes(std::uint64_t cycle, SimTime now) {
     if (w.recovery || !d.wkcOk()) continue;
     if (w.health.condition == SlaveCondition::kOperational) continue;
     if (w.health.condition == SlaveCondition::kFailed && cycle < w.retryAt) continue;
-    const std::uint16_t station = readLe16(d.data(), 0);
+    const std::uint16_t station = d.get(reg::kConfiguredStationAddress);
     if (station == slaveInfos_[i].station) continue;  // the status read will see it
     event(MasterEventKind::kSlaveReset, i, cycle, now,
           "answers at its position with station address " + std::to_string(station) +

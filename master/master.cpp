@@ -9,9 +9,6 @@
 namespace ecsim::master {
 namespace {
 
-constexpr std::uint16_t kAlStatusLength =
-    static_cast<std::uint16_t>(reg::kAlStatusCode.end() - reg::kAlStatus.address);
-
 int rank(AlState s) {
   switch (s) {
     case AlState::kInit:
@@ -147,16 +144,15 @@ Status Master::setupMailboxes() {
 Status Master::readStates() {
   DatagramBatch batch;
   for (const auto& slave : slaves_) {
-    batch.add().fprd(slave.station, reg::kAlStatus.address, kAlStatusLength);
+    batch.add().fprd(slave.station, reg::kAlStatus, reg::kAlStatusCode);
   }
   batch.queueAll(transport_);
   BatchWait wait(batch);
   ECSIM_TRY(run(wait, options_.state.timeout, "AL status"));
   ECSIM_TRY(batch.check());
   for (std::size_t i = 0; i < slaves_.size(); ++i) {
-    slaves_[i].alStatus = readLe16(batch[i].data(), 0);
-    slaves_[i].alStatusCode =
-        readLe16(batch[i].data(), reg::kAlStatusCode.address - reg::kAlStatus.address);
+    slaves_[i].alStatus = batch[i].get(reg::kAlStatus);
+    slaves_[i].alStatusCode = batch[i].get(reg::kAlStatusCode);
   }
   return okStatus();
 }

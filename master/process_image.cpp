@@ -41,7 +41,8 @@ Status layoutSlave(const SlaveInfo& slave, const SlaveProcessData& data, SlaveLa
     SmLayout sm;
     sm.sm = assignment.sm;
     sm.outputs = assignment.outputs;
-    sm.setting = {sii.startAddress, static_cast<std::uint16_t>(bytes), sii.control, bytes > 0};
+    sm.setting = syncManagerChannel(sii.startAddress, static_cast<std::uint16_t>(bytes), sii.control,
+                                    bytes > 0);
     sm.bitLength = bits;
     sm.pdos = assignment.pdos;
     out.sms.push_back(std::move(sm));
@@ -150,16 +151,18 @@ Result<ProcessImageLayout> planProcessImage(const std::vector<SlaveInfo>& slaves
   return layout;
 }
 
-std::vector<FmmuSetting> fmmusOf(const SlaveLayout& slave) {
-  std::vector<FmmuSetting> fmmus;
+std::vector<FmmuBlock> fmmusOf(const SlaveLayout& slave) {
+  std::vector<FmmuBlock> fmmus;
   for (bool outputs : {true, false}) {
     for (const auto& sm : slave.sms) {
       if (sm.outputs != outputs || sm.setting.length == 0) continue;
-      FmmuSetting f;
+      FmmuBlock f;
       f.logicalStart = sm.logicalStart;
       f.length = sm.setting.length;
       f.physicalStart = sm.setting.start;
-      f.type = outputs ? reg::fmmu::kTypeWrite : reg::fmmu::kTypeRead;
+      f.write = outputs;
+      f.read = !outputs;
+      f.enable = true;
       fmmus.push_back(f);
     }
   }
@@ -169,15 +172,13 @@ std::vector<FmmuSetting> fmmusOf(const SlaveLayout& slave) {
 void addProcessDataSetup(DatagramBatch& batch, const ProcessImageLayout& layout) {
   for (const auto& sl : layout.slaves) {
     for (const auto& sm : sl.sms) {
-      batch.add().fpwr(sl.station, reg::smChannel(sm.sm), encodeSyncManager(sm.setting));
+      batch.add().fpwr(sl.station, reg::smChannel(sm.sm), sm.setting.bytes());
     }
     const std::size_t channels = std::max<std::size_t>(sl.fmmuCount, sl.fmmus.size());
     if (channels == 0) continue;
     std::vector<std::uint8_t> fmmus(channels * reg::kFmmuSize, 0);
     for (std::size_t n = 0; n < sl.fmmus.size(); ++n) {
-      const auto bytes = encodeFmmu(sl.fmmus[n]);
-      std::copy(bytes.begin(), bytes.end(),
-                fmmus.begin() + static_cast<std::ptrdiff_t>(n * reg::kFmmuSize));
+      sl.fmmus[n].emit(Bytes(fmmus).subspan(n * reg::kFmmuSize));
     }
     batch.add().fpwr(sl.station, reg::fmmuChannel(0), fmmus);
   }

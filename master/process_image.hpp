@@ -35,7 +35,7 @@ namespace ecsim::master {
 struct SmLayout {
   unsigned sm{0};
   bool outputs{true};
-  SyncManagerSetting setting;
+  SyncManagerBlock setting;
   std::uint32_t bitLength{0};
   std::uint32_t logicalStart{0};  // meaningful when setting.length > 0
   std::vector<PdoInfo> pdos;
@@ -45,7 +45,7 @@ struct SlaveLayout {
   std::size_t position{0};
   std::uint16_t station{0};
   std::vector<SmLayout> sms;
-  std::vector<FmmuSetting> fmmus;  // FMMU n = fmmus[n]
+  std::vector<FmmuBlock> fmmus;  // FMMU n = fmmus[n]
   std::uint8_t fmmuCount{0};       // the ESC's FMMUs, all written (the unused ones cleared)
   std::uint32_t outputOffset{0};   // in the process image
   std::uint32_t outputBytes{0};
@@ -106,7 +106,7 @@ Result<ProcessImageLayout> planProcessImage(const std::vector<SlaveInfo>& slaves
 
 // One FMMU per SM with data, outputs first: logical range -> SM start, type write for outputs,
 // read for inputs (after the SMs' logicalStart are set).
-std::vector<FmmuSetting> fmmusOf(const SlaveLayout& slave);
+std::vector<FmmuBlock> fmmusOf(const SlaveLayout& slave);
 
 // The SM and FMMU writes of the layout, one FPWR per SM and one per slave for its FMMUs.
 void addProcessDataSetup(DatagramBatch& batch, const ProcessImageLayout& layout);

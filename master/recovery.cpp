@@ -13,9 +13,6 @@ constexpr std::uint16_t kEepromReadLength = static_cast<std::uint16_t>(
 constexpr std::size_t kEepromDataOffset = reg::kSiiData.address - reg::kSiiControlStatus.address;
 constexpr std::size_t kIdentityBytes = 8;             // vendor id, product code
 constexpr std::uint16_t kPdoAssignmentBase = 0x1C10;  // + SM number
-// The source clock's latched local time 0x0918 and its offset 0x0920 in one read.
-constexpr std::uint16_t kDcLatchAndOffsetLength = static_cast<std::uint16_t>(
-    reg::kSystemTimeOffset.end() - reg::kReceiveTimeEcatProcessingUnit.address);
 constexpr std::uint16_t kSpeedCounterRestart = 0x1000;  // 0x0930, as the DC set-up writes it
 
 std::string hex(unsigned v, int digits) {
@@ -199,17 +196,12 @@ void SlaveRecoveryTask::enter(Stage stage, SimTime now) {
   writes_.clear();
   switch (stage) {
     case Stage::kAddress: {
-      std::array<std::uint8_t, 2> station{};
-      writeLe16(station, 0, slave_.station);
-      batch_.add().prepare(Command::kApwr,
-                           DatagramHeader::physical(Datagram::autoIncrement(slave_.position),
-                                                    reg::kConfiguredStationAddress.address),
-                           station, 1);
+      batch_.add().write(Command::kApwr, Datagram::autoIncrement(slave_.position),
+                         reg::kConfiguredStationAddress, slave_.station);
       break;
     }
     case Stage::kIdentity: {
-      const std::array<std::uint8_t, 1> ecatOwnsEeprom{0};
-      batch_.add().fpwr(slave_.station, reg::kSiiConfiguration.address, ecatOwnsEeprom);
+      batch_.add().fpwr(slave_.station, reg::kSiiConfiguration, std::uint8_t{0});  // ECAT side
       identity_.clear();
       queueEepromRead(sii::kWordVendorId);
       return;
@@ -229,11 +221,8 @@ void SlaveRecoveryTask::enter(Stage stage, SimTime now) {
       // ESC follows at its fastest rate. Then one datagram latches the source clock's and this
       // slave's local time (0x0918) at the same point of the frame; the count of slaves that
       // latch is not checked.
-      batch_.add().fpwr(slave_.station, reg::kSpeedCounterStart.address,
-                        leBytes(kSpeedCounterRestart, 2));
-      batch_.add().prepare(Command::kBwr,
-                           DatagramHeader::physical(0, reg::kReceiveTimePort0.address),
-                           std::uint16_t{4}, 0);
+      batch_.add().fpwr(slave_.station, reg::kSpeedCounterStart, kSpeedCounterRestart);
+      batch_.add().write(Command::kBwr, 0, reg::kReceiveTimePort0, std::uint32_t{0}, 0);
       batch_.queueAll(transport_);
       sub_ = Sub::kDcLatch;
       return;
@@ -410,10 +399,10 @@ bool SlaveRecoveryTask::stepDc(SimTime now) {
       return false;
     }
     batch_.clear();
-    batch_.add().fprd(dc.sourceStation, reg::kReceiveTimeEcatProcessingUnit.address,
-                      kDcLatchAndOffsetLength);
-    batch_.add().fprd(slave_.station, reg::kReceiveTimeEcatProcessingUnit.address,
-                      reg::kReceiveTimeEcatProcessingUnit.width);
+    // The source clock's latched local time 0x0918 and its offset 0x0920 in one read.
+    batch_.add().fprd(dc.sourceStation, reg::kReceiveTimeEcatProcessingUnit,
+                      reg::kSystemTimeOffset);
+    batch_.add().fprd(slave_.station, reg::kReceiveTimeEcatProcessingUnit);
     batch_.queueAll(transport_);
     sub_ = Sub::kDcRead;
     return true;
@@ -430,28 +419,23 @@ bool SlaveRecoveryTask::stepDc(SimTime now) {
     return true;
   }
   // kDcRead answered: the source's system time at the latch, and this slave's local time.
-  const std::uint64_t sourceLocal = readLe64(batch_[0].data(), 0);
-  const std::uint64_t sourceOffset =
-      readLe64(batch_[0].data(),
-               reg::kSystemTimeOffset.address - reg::kReceiveTimeEcatProcessingUnit.address);
-  const std::uint64_t slaveLocal = readLe64(batch_[1].data(), 0);
+  const std::uint64_t sourceLocal = batch_[0].get(reg::kReceiveTimeEcatProcessingUnit);
+  const std::uint64_t sourceOffset = batch_[0].get(reg::kSystemTimeOffset);
+  const std::uint64_t slaveLocal = batch_[1].get(reg::kReceiveTimeEcatProcessingUnit);
   const std::uint64_t sourceTime = sourceLocal + sourceOffset;
   batch_.clear();
-  batch_.add().fpwr(slave_.station, reg::kSystemTimeDelay.address,
-                    leBytes(static_cast<std::uint32_t>(dc.delay), 4));
+  batch_.add().fpwr(slave_.station, reg::kSystemTimeDelay, static_cast<std::uint32_t>(dc.delay));
   batch_.add().fpwr(
-      slave_.station, reg::kSystemTimeOffset.address,
-      leBytes(recoveredDcOffset(sourceLocal, sourceOffset, slaveLocal, dc.delay - dc.sourceDelay),
-              8));
-  batch_.add().fpwr(slave_.station, reg::kSpeedCounterStart.address,
-                    leBytes(kSpeedCounterRestart, 2));
+      slave_.station, reg::kSystemTimeOffset,
+      recoveredDcOffset(sourceLocal, sourceOffset, slaveLocal, dc.delay - dc.sourceDelay));
+  batch_.add().fpwr(slave_.station, reg::kSpeedCounterStart, kSpeedCounterRestart);
   if (dc.sync0) {
     const std::uint64_t start = nextSync0Time(
         dc.sync0Start, dc.sync0Cycle, sourceTime + static_cast<std::uint64_t>(dc.sync0Margin));
-    batch_.add().fpwr(slave_.station, reg::kDcActivation.address, leBytes(0, 1));
-    batch_.add().fpwr(slave_.station, reg::kSync0CycleTime.address,
-                      leBytes(static_cast<std::uint32_t>(dc.sync0Cycle), 4));
-    batch_.add().fpwr(slave_.station, reg::kStartTimeCyclicOperation.address, leBytes(start, 8));
+    batch_.add().fpwr(slave_.station, reg::kDcActivation, std::uint8_t{0});
+    batch_.add().fpwr(slave_.station, reg::kSync0CycleTime,
+                      static_cast<std::uint32_t>(dc.sync0Cycle));
+    batch_.add().fpwr(slave_.station, reg::kStartTimeCyclicOperation, start);
     batch_.add().fpwr(slave_.station, reg::kCyclicUnitControl.address,
                       leBytes(dc.assignActivate, 2));
   }

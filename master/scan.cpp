@@ -10,10 +10,6 @@ namespace ecsim::master {
 namespace {
 
 // Register reads of the scan, in the order queued per slave.
-constexpr std::uint16_t kEscInfoLength =
-    static_cast<std::uint16_t>(reg::kEscFeatures.end() - reg::kType.address);
-constexpr std::uint16_t kAlStatusLength =
-    static_cast<std::uint16_t>(reg::kAlStatusCode.end() - reg::kAlStatus.address);
 constexpr std::size_t kReadsPerSlave = 5;
 
 // SII General category defaults for the mailbox control bytes (SOEM's values, §3.2).
@@ -105,7 +101,7 @@ void ScanTask::start(SimTime /*now*/) {
   readers_.clear();
   batch_.clear();
   status_ = okStatus();
-  count_.prepare(Command::kBrd, DatagramHeader::physical(0, reg::kType.address), 2, 0);
+  count_.read(Command::kBrd, 0, reg::kType, reg::kRevision, 0);
   transport_.queue(count_);
   state_ = State::kCount;
 }
@@ -128,30 +124,34 @@ std::optional<SimTime> ScanTask::wakeAt() const {
 void ScanTask::queueDefaults() {
   batch_.clear();
   const auto n = static_cast<std::uint16_t>(slaves_.size());
-  auto bwr = [&](std::uint16_t address, std::initializer_list<std::uint8_t> bytes,
-                 std::uint16_t expected) {
+  auto bwr = [&](std::uint16_t address, std::initializer_list<std::uint8_t> bytes) {
     std::vector<std::uint8_t> data(bytes);
-    batch_.add().prepare(Command::kBwr, DatagramHeader::physical(0, address), data, expected);
+    batch_.add().prepare(Command::kBwr, DatagramHeader::physical(0, address), data, 0);
   };
   auto bwrZero = [&](std::uint16_t address, std::uint16_t length) {
     batch_.add().prepare(Command::kBwr, DatagramHeader::physical(0, address), length, 0);
   };
+  auto set = [&](auto r, typename decltype(r)::Value value) {
+    batch_.add().write(Command::kBwr, 0, r, value, 0);
+  };
   // INIT with error acknowledge first; its WKC is checked (every slave must take it).
-  bwr(reg::kAlControl.address,
-      {static_cast<std::uint8_t>(kAlErrorFlag | static_cast<std::uint16_t>(AlState::kInit)), 0}, n);
+  batch_.add().write(Command::kBwr, 0, reg::kAlControl,
+                     static_cast<std::uint16_t>(kAlErrorFlag | static_cast<std::uint16_t>(AlState::kInit)),
+                     n);
   // The other writes are best effort: an ESC without DC, say, need not count them.
-  bwr(static_cast<std::uint16_t>(reg::kDlControl.address + 1), {0}, 0);  // loop control: auto
-  bwr(static_cast<std::uint16_t>(reg::kDlControl.address + 3), {0}, 0);  // station alias off
-  bwr(reg::kEcatEventMask.address, {0x04, 0x00}, 0);                     // AL status event
+  bwr(static_cast<std::uint16_t>(reg::kDlControl.address + 1), {0});  // loop control: auto
+  bwr(static_cast<std::uint16_t>(reg::kDlControl.address + 3), {0});  // station alias off
+  set(reg::kEcatEventMask, 0x0004);                                   // AL status event
   bwrZero(reg::rxErrorCounters(0), 8);
   bwrZero(reg::fmmuChannel(0), 3 * reg::kFmmuSize);
   bwrZero(reg::smChannel(0), 4 * reg::kSmSize);
-  bwr(reg::kDcActivation.address, {0}, 0);
-  bwrZero(reg::kSystemTime.address, 4);
-  bwr(reg::kSpeedCounterStart.address, {0x00, 0x10}, 0);                // 0x1000
-  bwr(reg::kSystemTimeDifferenceFilterDepth.address, {0x00, 0x0C}, 0);  // and speed filter 12
-  bwr(reg::kSiiConfiguration.address, {0x02}, 0);  // force the EEPROM to the ECAT side...
-  bwr(reg::kSiiConfiguration.address, {0x00}, 0);  // ...and leave it there
+  set(reg::kDcActivation, 0);
+  bwrZero(reg::kSystemTime.address, 4);  // the 32-bit local time of an ESC with 32-bit DC
+  set(reg::kSpeedCounterStart, 0x1000);
+  // Difference filter depth 0 and speed counter filter depth 12, in one datagram (as SOEM).
+  bwr(reg::kSystemTimeDifferenceFilterDepth.address, {0x00, 0x0C});
+  set(reg::kSiiConfiguration, 0x02);  // force the EEPROM to the ECAT side...
+  set(reg::kSiiConfiguration, 0x00);  // ...and leave it there
   batch_.queueAll(transport_);
 }
 
@@ -160,19 +160,13 @@ void ScanTask::queueAddresses() {
   if (!options_.resetToDefaults) {
     // Leave the slaves as they are, but the SII must be readable from the EtherCAT side.
     for (std::uint8_t value : {std::uint8_t{0x02}, std::uint8_t{0x00}}) {
-      const std::array<std::uint8_t, 1> data{value};
-      batch_.add().prepare(Command::kBwr,
-                           DatagramHeader::physical(0, reg::kSiiConfiguration.address), data,
-                           static_cast<std::uint16_t>(slaves_.size()));
+      batch_.add().write(Command::kBwr, 0, reg::kSiiConfiguration, value,
+                         static_cast<std::uint16_t>(slaves_.size()));
     }
   }
   for (auto& slave : slaves_) {
-    std::array<std::uint8_t, 2> address{};
-    writeLe16(address, 0, slave.station);
-    batch_.add().prepare(Command::kApwr,
-                         DatagramHeader::physical(Datagram::autoIncrement(slave.position),
-                                                  reg::kConfiguredStationAddress.address),
-                         address, 1);
+    batch_.add().write(Command::kApwr, Datagram::autoIncrement(slave.position),
+                       reg::kConfiguredStationAddress, slave.station);
   }
   batch_.queueAll(transport_);
 }
@@ -180,11 +174,11 @@ void ScanTask::queueAddresses() {
 void ScanTask::queueRegisters() {
   batch_.clear();
   for (auto& slave : slaves_) {
-    batch_.add().fprd(slave.station, reg::kType.address, kEscInfoLength);
-    batch_.add().fprd(slave.station, reg::kConfiguredStationAlias.address, 2);
-    batch_.add().fprd(slave.station, reg::kDlStatus.address, 2);
-    batch_.add().fprd(slave.station, reg::kAlStatus.address, kAlStatusLength);
-    batch_.add().fprd(slave.station, reg::kSiiControlStatus.address, 2);
+    batch_.add().fprd(slave.station, reg::kType, reg::kEscFeatures);
+    batch_.add().fprd(slave.station, reg::kConfiguredStationAlias);
+    batch_.add().fprd(slave.station, reg::kDlStatus);
+    batch_.add().fprd(slave.station, reg::kAlStatus, reg::kAlStatusCode);
+    batch_.add().fprd(slave.station, reg::kSiiControlStatus);
   }
   batch_.queueAll(transport_);
 }
@@ -192,21 +186,21 @@ void ScanTask::queueRegisters() {
 void ScanTask::takeRegisters() {
   for (auto& slave : slaves_) {
     const std::size_t base = slave.position * kReadsPerSlave;
-    ConstBytes info = batch_[base].data();
-    slave.escType = info[reg::kType.address];
-    slave.escRevision = info[reg::kRevision.address];
-    slave.escBuild = readLe16(info, reg::kBuild.address);
-    slave.fmmuCount = info[reg::kFmmusSupported.address];
-    slave.syncManagerCount = info[reg::kSyncManagersSupported.address];
-    slave.ramKb = info[reg::kRamSize.address];
-    slave.portDescriptor = info[reg::kPortDescriptor.address];
-    slave.features = readLe16(info, reg::kEscFeatures.address);
-    slave.alias = readLe16(batch_[base + 1].data(), 0);
-    slave.dlStatus = readLe16(batch_[base + 2].data(), 0);
-    ConstBytes al = batch_[base + 3].data();
-    slave.alStatus = readLe16(al, 0);
-    slave.alStatusCode = readLe16(al, reg::kAlStatusCode.address - reg::kAlStatus.address);
-    slave.siiReads8Bytes = (readLe16(batch_[base + 4].data(), 0) & reg::sii::kReadSize8Bytes) != 0;
+    const Datagram& info = batch_[base];
+    slave.escType = info.get(reg::kType);
+    slave.escRevision = info.get(reg::kRevision);
+    slave.escBuild = info.get(reg::kBuild);
+    slave.fmmuCount = info.get(reg::kFmmusSupported);
+    slave.syncManagerCount = info.get(reg::kSyncManagersSupported);
+    slave.ramKb = info.get(reg::kRamSize);
+    slave.portDescriptor = info.get(reg::kPortDescriptor);
+    slave.features = info.get(reg::kEscFeatures);
+    slave.alias = batch_[base + 1].get(reg::kConfiguredStationAlias);
+    slave.dlStatus = batch_[base + 2].get(reg::kDlStatus);
+    slave.alStatus = batch_[base + 3].get(reg::kAlStatus);
+    slave.alStatusCode = batch_[base + 3].get(reg::kAlStatusCode);
+    slave.siiReads8Bytes =
+        (batch_[base + 4].get(reg::kSiiControlStatus) & reg::sii::kReadSize8Bytes) != 0;
   }
   computeTopology(slaves_);
 }

@@ -1,24 +1,8 @@
 #include "master/state_change.hpp"
 
-#include <array>
-
 #include "protocol/registers.hpp"
 
 namespace ecsim::master {
-namespace {
-
-constexpr std::uint16_t kAlStatusLength =
-    static_cast<std::uint16_t>(reg::kAlStatusCode.end() - reg::kAlStatus.address);
-constexpr std::size_t kCodeOffset = reg::kAlStatusCode.address - reg::kAlStatus.address;
-
-std::array<std::uint8_t, 2> alControl(std::uint16_t value) {
-  std::array<std::uint8_t, 2> bytes{};
-  writeLe16(bytes, 0, value);
-  return bytes;
-}
-
-}  // namespace
-
 std::string StateRefusal::describe() const {
   SlaveInfo who;
   who.position = position;
@@ -56,7 +40,7 @@ void StateChangeTask::queueReads(bool onlyPending) {
   reading_.clear();
   for (const auto& slave : slaves_) {
     if (onlyPending && outcome_[slave.position] != Outcome::kPending) continue;
-    batch_.add().fprd(slave.station, reg::kAlStatus.address, kAlStatusLength);
+    batch_.add().fprd(slave.station, reg::kAlStatus, reg::kAlStatusCode);
     reading_.push_back(slave.position);
   }
   batch_.queueAll(transport_);
@@ -69,8 +53,8 @@ bool StateChangeTask::takeReads(SimTime /*now*/) {
   }
   for (std::size_t i = 0; i < reading_.size(); ++i) {
     SlaveInfo& slave = slaves_[reading_[i]];
-    slave.alStatus = readLe16(batch_[i].data(), 0);
-    slave.alStatusCode = readLe16(batch_[i].data(), kCodeOffset);
+    slave.alStatus = batch_[i].get(reg::kAlStatus);
+    slave.alStatusCode = batch_[i].get(reg::kAlStatusCode);
   }
   return true;
 }
@@ -99,7 +83,7 @@ bool StateChangeTask::step(SimTime now) {
       for (const auto& slave : slaves_) {
         std::uint16_t value = static_cast<std::uint16_t>(target_);
         if (slave.alError() && options_.acknowledgeErrors) value |= kAlErrorFlag;
-        batch_.add().fpwr(slave.station, reg::kAlControl.address, alControl(value));
+        batch_.add().fpwr(slave.station, reg::kAlControl, value);
       }
       batch_.queueAll(transport_);
       state_ = State::kRequest;
@@ -150,9 +134,9 @@ bool StateChangeTask::step(SimTime now) {
           refusals_.push_back(std::move(r));
           outcome_[position] = Outcome::kRefused;
           if (options_.acknowledgeErrors) {
-            acks_.add().fpwr(slave.station, reg::kAlControl.address,
-                             alControl(static_cast<std::uint16_t>((slave.alStatus & kAlStateMask) |
-                                                                  kAlErrorFlag)));
+            acks_.add().fpwr(slave.station, reg::kAlControl,
+                             static_cast<std::uint16_t>((slave.alStatus & kAlStateMask) |
+                                                        kAlErrorFlag));
           }
         } else if (slave.state() == target_) {
           outcome_[position] = Outcome::kReached;

@@ -24,6 +24,29 @@ struct Reg {
   constexpr std::uint16_t end() const { return static_cast<std::uint16_t>(address + width); }
 };
 
+// The bytes from `first` through `last` (one read that covers several registers, e.g. AL
+// status through AL status code).
+template <typename T, typename U>
+constexpr std::uint16_t spanWidth(Reg<T> first, Reg<U> last) {
+  return static_cast<std::uint16_t>(last.end() - first.address);
+}
+
+// Register r in `bytes` that hold the register space from address `base` on (little-endian,
+// as on the wire). The bytes must cover r.
+template <typename T>
+T valueIn(Reg<T> r, std::span<const std::uint8_t> bytes, std::uint16_t base) {
+  std::uint64_t v = 0;
+  for (unsigned i = 0; i < sizeof(T); ++i)
+    v |= static_cast<std::uint64_t>(bytes[r.address - base + i]) << (8 * i);
+  return static_cast<T>(v);
+}
+template <typename T>
+void putIn(Reg<T> r, std::span<std::uint8_t> bytes, std::uint16_t base, T value) {
+  const auto v = static_cast<std::uint64_t>(value);
+  for (unsigned i = 0; i < sizeof(T); ++i)
+    bytes[r.address - base + i] = static_cast<std::uint8_t>(v >> (8 * i));
+}
+
 // A register block that is not a scalar (e.g. 0x0508 SII data, 4 or 8 bytes).
 struct Block {
   std::uint16_t address;
@@ -140,6 +163,9 @@ inline constexpr Reg<std::uint8_t> kType{0xB, "Type"};
 inline constexpr Reg<std::uint8_t> kActivate{0xC, "Activate"};
 inline constexpr std::uint8_t kTypeRead = 0x01;   // ECAT read access (inputs)
 inline constexpr std::uint8_t kTypeWrite = 0x02;  // ECAT write access (outputs)
+inline constexpr std::uint8_t kActivateEnable = 0x01;
+inline constexpr std::uint8_t kBitMask = 0x07;  // start/stop bit registers: bits 2:0
+inline constexpr Block kReserved{0xD, 3, "Reserved"};
 }  // namespace fmmu
 constexpr std::uint16_t fmmuChannel(unsigned n) {
   return static_cast<std::uint16_t>(kFmmuBase + kFmmuSize * n);
@@ -193,6 +219,8 @@ inline constexpr Reg<std::uint32_t> kReceiveTimePort0{0x0900, "Receive Time Port
 inline constexpr Reg<std::uint32_t> kReceiveTimePort1{0x0904, "Receive Time Port 1"};
 inline constexpr Reg<std::uint32_t> kReceiveTimePort2{0x0908, "Receive Time Port 2"};
 inline constexpr Reg<std::uint32_t> kReceiveTimePort3{0x090C, "Receive Time Port 3"};
+inline constexpr std::array<Reg<std::uint32_t>, 4> kReceiveTimePorts{
+    kReceiveTimePort0, kReceiveTimePort1, kReceiveTimePort2, kReceiveTimePort3};
 inline constexpr Reg<std::uint64_t> kSystemTime{0x0910, "System Time"};
 inline constexpr Reg<std::uint64_t> kReceiveTimeEcatProcessingUnit{
     0x0918, "Receive Time ECAT Processing Unit"};

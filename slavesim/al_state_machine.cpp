@@ -31,9 +31,7 @@ std::uint16_t AlStateMachine::checkMailbox(const Esc& esc, const SlaveProfile::M
   auto out = esc.smConfig(0);
   auto in = esc.smConfig(1);
   auto ok = [](const Esc::SmConfig& c, std::uint16_t start, std::uint16_t size, bool write) {
-    return c.enabled && (c.control & reg::sm::kControlModeMask) == reg::sm::kControlModeMailbox &&
-           ((c.control & reg::sm::kControlDirectionMask) == reg::sm::kControlDirectionWrite) ==
-               write &&
+    return c.enabled && c.control.isMailbox() && c.control.isEcatWrite() == write &&
            c.start == start && c.length >= 8 && c.length <= size;
   };
   if (!ok(out, mbx.outStart, mbx.outSize, true) || !ok(in, mbx.inStart, mbx.inSize, false)) {
@@ -46,13 +44,11 @@ std::uint16_t AlStateMachine::checkProcessData(const Esc& esc, const SlaveProfil
   for (const auto& pd : profile.processData) {
     if (pd.length == 0) continue;
     auto c = esc.smConfig(pd.index);
-    const bool write =
-        (c.control & reg::sm::kControlDirectionMask) == reg::sm::kControlDirectionWrite;
+    const bool write = c.control.isEcatWrite();
     // Process data may use a 3-buffer or a 1-buffer (mailbox-mode) SM: both are valid ESC
     // configurations (some devices' ESI ask for 1-buffer, e.g. the EL9800 evaluation board).
-    const std::uint8_t mode = c.control & reg::sm::kControlModeMask;
     const bool validMode =
-        mode == reg::sm::kControlModeBuffered || mode == reg::sm::kControlModeMailbox;
+        c.control.mode == SmMode::kBuffered || c.control.mode == SmMode::kMailbox;
     if (!c.enabled || !validMode || write != pd.outputs || c.length != pd.length) {
       return code(pd.outputs ? AlStatusCode::kInvalidOutputConfiguration
                              : AlStatusCode::kInvalidInputConfiguration);

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "protocol/bytes.hpp"
+#include "protocol/esc_blocks.hpp"
 #include "protocol/frame.hpp"
 #include "protocol/registers.hpp"
 #include "protocol/time.hpp"
@@ -119,24 +120,13 @@ class Esc {
   }
   bool pdiWriteInputs(unsigned sm, ConstBytes data);
 
-  // SM configuration as the master programmed it.
-  struct SmConfig {
-    std::uint16_t start{0};
-    std::uint16_t length{0};
-    std::uint8_t control{0};
+  // SM configuration as the master programmed it: the channel as protocol/esc_blocks.hpp
+  // decodes it, plus whether it works (enabled, not deactivated by the PDI, inside memory).
+  struct SmConfig : SyncManagerBlock {
     bool enabled{false};
   };
   SmConfig smConfig(unsigned sm) const;
-  struct FmmuConfig {
-    std::uint32_t logicalStart{0};
-    std::uint16_t length{0};
-    std::uint8_t logicalStartBit{0};
-    std::uint8_t logicalStopBit{7};
-    std::uint16_t physicalStart{0};
-    std::uint8_t physicalStartBit{0};
-    std::uint8_t type{0};
-    bool active{false};
-  };
+  using FmmuConfig = FmmuBlock;
   FmmuConfig fmmuConfig(unsigned n) const;
 
   const EscEvents& peekEvents() const { return events_; }

@@ -9,31 +9,22 @@
 namespace ecsim::slavesim {
 using namespace esc_detail;
 Esc::FmmuConfig Esc::fmmuConfig(unsigned n) const {
-  std::uint16_t base = reg::fmmuChannel(n);
-  FmmuConfig f;
-  f.logicalStart = readLe32(memory_, base + reg::fmmu::kLogicalStart.address);
-  f.length = readLe16(memory_, base + reg::fmmu::kLength.address);
-  f.logicalStartBit = memory_[base + reg::fmmu::kLogicalStartBit.address];
-  f.logicalStopBit = memory_[base + reg::fmmu::kLogicalStopBit.address];
-  f.physicalStart = readLe16(memory_, base + reg::fmmu::kPhysicalStart.address);
-  f.physicalStartBit = memory_[base + reg::fmmu::kPhysicalStartBit.address];
-  f.type = memory_[base + reg::fmmu::kType.address];
-  f.active = (memory_[base + reg::fmmu::kActivate.address] & 0x01) != 0;
-  return f;
+  return FmmuBlock::parse(ConstBytes(memory_).subspan(reg::fmmuChannel(n), reg::kFmmuSize)).value();
 }
 
 void Esc::rebuildFmmuCache() {
   activeFmmuCount_ = 0;
   for (unsigned n = 0; n < type_.fmmus; ++n) {
     FmmuConfig f = fmmuConfig(n);
-    if (!f.active || f.length == 0 || (f.type & 0x03) == 0) continue;
+    if (!f.enable || f.length == 0 || (!f.read && !f.write)) continue;
     ActiveFmmu a;
     a.logicalStartBit = static_cast<std::uint64_t>(f.logicalStart) * 8 + (f.logicalStartBit & 7);
     a.logicalEndBit =
         (static_cast<std::uint64_t>(f.logicalStart) + f.length - 1) * 8 + (f.logicalStopBit & 7);
     if (a.logicalEndBit < a.logicalStartBit) continue;
     a.physicalStartBit = static_cast<std::uint32_t>(f.physicalStart) * 8 + (f.physicalStartBit & 7);
-    a.type = f.type;
+    a.type = static_cast<std::uint8_t>((f.read ? reg::fmmu::kTypeRead : 0) |
+                                       (f.write ? reg::fmmu::kTypeWrite : 0));
     a.byteAligned = (f.logicalStartBit & 7) == 0 && (f.logicalStopBit & 7) == 7 &&
                     (f.physicalStartBit & 7) == 0;
     activeFmmus_[activeFmmuCount_++] = a;

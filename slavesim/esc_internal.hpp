@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 
+#include "protocol/esc_blocks.hpp"
 #include "protocol/registers.hpp"
 #include "protocol/time.hpp"
 
@@ -21,11 +22,11 @@ inline bool overlaps(std::uint32_t begin, std::uint32_t end, std::uint16_t regBe
   return begin < static_cast<std::uint32_t>(regBegin + width) && regBegin < end;
 }
 
-inline bool isMailbox(std::uint8_t control) {
-  return (control & reg::sm::kControlModeMask) == reg::sm::kControlModeMailbox;
+inline bool isMailbox(const SmControl& control) {
+  return control.isMailbox();
 }
-inline bool isEcatWrite(std::uint8_t control) {
-  return (control & reg::sm::kControlDirectionMask) == reg::sm::kControlDirectionWrite;
+inline bool isEcatWrite(const SmControl& control) {
+  return control.isEcatWrite();
 }
 
 }  // namespace ecsim::slavesim::esc_detail

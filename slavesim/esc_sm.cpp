@@ -33,16 +33,13 @@ void Esc::rebuildSmCache() {
 }
 
 Esc::SmConfig Esc::smConfig(unsigned s) const {
-  std::uint16_t base = reg::smChannel(s);
+  const std::uint16_t base = reg::smChannel(s);
   SmConfig c;
-  c.start = readLe16(memory_, base + reg::sm::kPhysicalStart.address);
-  c.length = readLe16(memory_, base + reg::sm::kLength.address);
-  c.control = memory_[base + reg::sm::kControl.address];
+  static_cast<SyncManagerBlock&>(c) =
+      SyncManagerBlock::parse(ConstBytes(memory_).subspan(base, reg::kSmSize)).value();
   // An SM that does not exist on this ESC, or whose area runs past the ESC's memory, never
   // works: treated as disabled (so no buffer logic can reach outside the memory).
-  c.enabled = s < type_.syncManagers &&
-              (memory_[base + reg::sm::kActivate.address] & reg::sm::kActivateEnable) != 0 &&
-              (memory_[base + reg::sm::kPdiControl.address] & reg::sm::kPdiDeactivate) == 0 &&
+  c.enabled = s < type_.syncManagers && c.activate.enable && !c.pdiControl.deactivate &&
               static_cast<std::size_t>(c.start) + c.length <= memory_.size();
   return c;
 }
@@ -105,7 +102,7 @@ bool Esc::writeRam(std::uint16_t address, ConstBytes data, int smIndex) {
       return false;  // full: write refused, no WKC (the master retries)
     }
     std::copy(data.begin(), data.end(), memory_.begin() + address);
-    if ((cfg.control & reg::sm::kControlWatchdog) != 0) triggerPdWatchdog();
+    if (cfg.control.watchdogTrigger) triggerPdWatchdog();
     if (lastByte) {
       st.mailboxFull = true;
       st.hasLatest = true;  // for 1-buffer process data: outputs received
@@ -116,7 +113,7 @@ bool Esc::writeRam(std::uint16_t address, ConstBytes data, int smIndex) {
     return true;
   }
   if (!isEcatWrite(cfg.control)) return false;  // inputs: master writes are ignored
-  if ((cfg.control & reg::sm::kControlWatchdog) != 0) triggerPdWatchdog();
+  if (cfg.control.watchdogTrigger) triggerPdWatchdog();
   const std::size_t offset = static_cast<std::size_t>(address - cfg.start);
   const std::size_t bufBase = 3u * static_cast<std::size_t>(cfg.start);
   std::copy(

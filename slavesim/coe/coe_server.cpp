@@ -16,9 +16,7 @@ constexpr std::size_t kMinimumBuffer = 64;  // room for any fixed-size reply
 std::size_t sendMailboxSize(const Esc& esc) {
   for (unsigned s = 0; s < esc.type().syncManagers; ++s) {
     const Esc::SmConfig c = esc.smConfig(s);
-    if (c.enabled && c.length > 0 &&
-        (c.control & reg::sm::kControlModeMask) == reg::sm::kControlModeMailbox &&
-        (c.control & reg::sm::kControlDirectionMask) != reg::sm::kControlDirectionWrite) {
+    if (c.enabled && c.length > 0 && c.control.isMailbox() && !c.control.isEcatWrite()) {
       return c.length;
     }
   }

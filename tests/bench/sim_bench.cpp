@@ -17,6 +17,7 @@
 
 #include "config/topology_file.hpp"
 #include "protocol/frame.hpp"
+#include "protocol/esc_blocks.hpp"
 #include "protocol/registers.hpp"
 #include "slavesim/generic_slave.hpp"
 #include "topology/network_builder.hpp"
@@ -44,15 +45,17 @@ void configure(topology::Segment& seg, std::size_t n) {
                                   reg::kConfiguredStationAddress.address),
          {static_cast<std::uint8_t>(station), static_cast<std::uint8_t>(station >> 8)});
     for (int dir = 0; dir < 2; ++dir) {  // FMMU0 outputs -> 0x1000, FMMU1 inputs <- 0x1100
-      std::vector<std::uint8_t> f(16, 0);
-      writeLe32(f, 0, static_cast<std::uint32_t>(i * kBytesPerSlave));
-      writeLe16(f, 4, kBytesPerSlave);
-      f[7] = 7;
-      writeLe16(f, 8, dir == 0 ? 0x1000 : 0x1100);
-      f[11] = dir == 0 ? reg::fmmu::kTypeWrite : reg::fmmu::kTypeRead;
-      f[12] = 1;
+      FmmuBlock f;
+      f.logicalStart = static_cast<std::uint32_t>(i * kBytesPerSlave);
+      f.length = kBytesPerSlave;
+      f.physicalStart = dir == 0 ? 0x1000 : 0x1100;
+      f.write = dir == 0;
+      f.read = dir != 0;
+      f.enable = true;
+      const auto bytes = f.bytes();
       send(seg, Command::kFpwr,
-           DatagramHeader::physical(station, reg::fmmuChannel(static_cast<unsigned>(dir))), f);
+           DatagramHeader::physical(station, reg::fmmuChannel(static_cast<unsigned>(dir))),
+           {bytes.begin(), bytes.end()});
     }
   }
 }

@@ -23,7 +23,7 @@ build=${1:-$repo/build/fuzz}
 runs=${2:-100000}
 shift $(($# < 2 ? $# : 2))
 all_targets=(fuzz_frame fuzz_mailbox fuzz_esc fuzz_esi fuzz_topology fuzz_eni fuzz_scenario
-             fuzz_master_config fuzz_control fuzz_sii fuzz_pcap)
+             fuzz_master_config fuzz_control fuzz_sii fuzz_pcap fuzz_esc_blocks)
 targets=("$@")
 if [[ ${#targets[@]} -eq 0 ]]; then targets=("${all_targets[@]}"); fi
 shared=${ECSIM_SHARED:-$repo/../shared}
@@ -65,6 +65,7 @@ max_len() {
   case $1 in
     fuzz_frame | fuzz_mailbox | fuzz_esc) echo 2048 ;;
     fuzz_master_config) echo 4096 ;;
+    fuzz_esc_blocks) echo 64 ;;  # an SM and an FMMU channel and the fields of one of each
     fuzz_control) echo 512 ;;  # a few lines: each costs a verb's work on the network
     fuzz_sii | fuzz_scenario) echo 8192 ;;
     fuzz_esi | fuzz_topology | fuzz_pcap) echo 16384 ;;

@@ -53,18 +53,18 @@ TEST(ProcessImageTest, OutputsThenInputsByteAlignedPerSlave) {
   EXPECT_EQ(layout->slaves[2].inputBytes, 6u);
   // SMs from the SII (start, control), lengths from the mapping.
   ASSERT_EQ(a.sms.size(), 2u);
-  EXPECT_EQ(a.sms[0].setting, (master::SyncManagerSetting{kIoOutputSm, 4, 0x64, true}));
-  EXPECT_EQ(a.sms[1].setting, (master::SyncManagerSetting{kIoInputSm, 4, 0x20, true}));
+  EXPECT_EQ(a.sms[0].setting, master::syncManagerChannel(kIoOutputSm, 4, 0x64, true));
+  EXPECT_EQ(a.sms[1].setting, master::syncManagerChannel(kIoInputSm, 4, 0x20, true));
   // An SM without data stays disabled.
-  EXPECT_FALSE(layout->slaves[1].sms[1].setting.enable);
+  EXPECT_FALSE(layout->slaves[1].sms[1].setting.activate.enable);
   // FMMUs: outputs first.
   ASSERT_EQ(a.fmmus.size(), 2u);
   EXPECT_EQ(a.fmmus[0].logicalStart, 0u);
   EXPECT_EQ(a.fmmus[0].length, 4);
   EXPECT_EQ(a.fmmus[0].physicalStart, kIoOutputSm);
-  EXPECT_EQ(a.fmmus[0].type, reg::fmmu::kTypeWrite);
+  EXPECT_TRUE(a.fmmus[0].write && !a.fmmus[0].read);
   EXPECT_EQ(a.fmmus[1].logicalStart, 6u);
-  EXPECT_EQ(a.fmmus[1].type, reg::fmmu::kTypeRead);
+  EXPECT_TRUE(a.fmmus[1].read && !a.fmmus[1].write);
   // One LRW over everything: WKC 3 + 2 + 1.
   ASSERT_EQ(layout->datagrams.size(), 1u);
   EXPECT_EQ(layout->datagrams[0].length, 16);

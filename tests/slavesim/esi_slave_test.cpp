@@ -174,7 +174,7 @@ Outcome driveLikeSoem(topology::Segment& seg) {
     detail << "; master set";
     for (const auto& [sm, b] : bits) {
       const auto c = seg.slave(0).esc().smConfig(sm);
-      detail << " SM" << sm << "=" << c.length << "/ctrl " << hex(c.control);
+      detail << " SM" << sm << "=" << c.length << "/ctrl " << hex(c.control.encode());
     }
     out.reason += detail.str() + ")";
     return out;

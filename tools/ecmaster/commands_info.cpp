@@ -297,13 +297,13 @@ int runPdos(const GlobalOptions& g, std::optional<std::size_t> position) {
       nlohmann::json jsm{{"sm", sm.sm},
                          {"outputs", sm.outputs},
                          {"start", sm.setting.start},
-                         {"control", sm.setting.control},
+                         {"control", sm.setting.control.encode()},
                          {"length", sm.setting.length},
                          {"logicalStart", sm.logicalStart}};
       if (!g.json) {
         fmt::print("  SM{} {:<7} start {} control {} length {:3}{}\n", sm.sm,
                    sm.outputs ? "outputs" : "inputs", hex(sm.setting.start, 4),
-                   hex(sm.setting.control, 2), sm.setting.length,
+                   hex(sm.setting.control.encode(), 2), sm.setting.length,
                    sm.setting.length > 0 ? "  logical " + hex(sm.logicalStart, 8) : "");
       }
       nlohmann::json pdos = nlohmann::json::array();

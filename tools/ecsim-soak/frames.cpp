@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "protocol/esc_blocks.hpp"
 #include "protocol/registers.hpp"
 
 namespace ecsim::soak {
@@ -302,20 +303,19 @@ void fmmuFrame(SoakFrame& out, std::uint16_t position) {
   FrameBuilder b(Bytes(out.bytes.data(), kMaxFrameSize), header(kValidMarker, out.sequence));
   std::array<std::uint8_t, 2 * reg::kFmmuSize> data{};
   const std::uint32_t logical = kLogicalBase + std::uint32_t{kBytesPerSlave} * position;
-  const std::array<std::pair<std::uint16_t, std::uint8_t>, 2> fmmus{{
-      {static_cast<std::uint16_t>(kRamStart + kOutputArea), reg::fmmu::kTypeWrite},
-      {static_cast<std::uint16_t>(kRamStart + kInputArea), reg::fmmu::kTypeRead},
+  const std::array<std::pair<std::uint16_t, bool>, 2> fmmus{{  // physical start, outputs
+      {static_cast<std::uint16_t>(kRamStart + kOutputArea), true},
+      {static_cast<std::uint16_t>(kRamStart + kInputArea), false},
   }};
   for (std::size_t k = 0; k < fmmus.size(); ++k) {
-    Bytes ch(data.data() + k * reg::kFmmuSize, reg::kFmmuSize);
-    writeLe32(ch, reg::fmmu::kLogicalStart.address, logical);
-    writeLe16(ch, reg::fmmu::kLength.address, kBytesPerSlave);
-    ch[reg::fmmu::kLogicalStartBit.address] = 0;
-    ch[reg::fmmu::kLogicalStopBit.address] = 7;
-    writeLe16(ch, reg::fmmu::kPhysicalStart.address, fmmus[k].first);
-    ch[reg::fmmu::kPhysicalStartBit.address] = 0;
-    ch[reg::fmmu::kType.address] = fmmus[k].second;
-    ch[reg::fmmu::kActivate.address] = 1;
+    FmmuBlock f;
+    f.logicalStart = logical;
+    f.length = kBytesPerSlave;
+    f.physicalStart = fmmus[k].first;
+    f.write = fmmus[k].second;
+    f.read = !fmmus[k].second;
+    f.enable = true;
+    f.emit(Bytes(data).subspan(k * reg::kFmmuSize));
   }
   (void)b.add(Command::kFpwr, 0, DatagramHeader::physical(station(position), reg::fmmuChannel(0)),
               data);
