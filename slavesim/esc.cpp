@@ -35,6 +35,9 @@ void Esc::reset() {
   sync_ = {};
   activeFmmuCount_ = 0;
   smRangeCount_ = 0;
+  smTriggerOnlyCount_ = 0;
+  smEndAccessed_ = 0;
+  invalidFrame_ = false;
   lastMailboxResponseSize_ = 0;
   memory_[reg::kType.address] = type_.typeRegister;
   memory_[reg::kRevision.address] = type_.revisionRegister;
@@ -110,7 +113,8 @@ void Esc::processDatagram(DatagramView d, SimTime time) {
       if (cmd == Command::kArmw || cmd == Command::kFrmw) {
         // Read at the addressed slave, write at every other one (datasheet Table 7).
         if (addressed) {
-          refreshVolatile(ado, static_cast<std::uint16_t>(std::min<std::uint32_t>(end, 0xFFFF)));
+          if (!invalidFrame_)  // register reads with side effects: discarded (section I §14.1)
+            refreshVolatile(ado, static_cast<std::uint16_t>(std::min<std::uint32_t>(end, 0xFFFF)));
           readMemory(ado, d.data(), false);
           inc = 1;
         } else if (writeMemory(ado, d.data())) {
@@ -122,7 +126,8 @@ void Esc::processDatagram(DatagramView d, SimTime time) {
       ++counters_.datagramsAddressed;
       CommandAccess access = commandAccess(cmd);
       if (access.read) {
-        refreshVolatile(ado, static_cast<std::uint16_t>(std::min<std::uint32_t>(end, 0xFFFF)));
+        if (!invalidFrame_)
+          refreshVolatile(ado, static_cast<std::uint16_t>(std::min<std::uint32_t>(end, 0xFFFF)));
         // Read-write commands: the data read is the memory before the write.
         if (access.write) {
           std::copy(d.data().begin(), d.data().end(), scratch_.begin());
@@ -133,7 +138,8 @@ void Esc::processDatagram(DatagramView d, SimTime time) {
           inc = readMemory(ado, d.data(), mode == AddressMode::kBroadcast) ? 1 : 0;
         }
       } else if (access.write) {
-        if (ado <= reg::kReceiveTimePort0.address && end > reg::kReceiveTimePort0.address) {
+        if (!invalidFrame_ && ado <= reg::kReceiveTimePort0.address &&
+            end > reg::kReceiveTimePort0.address) {
           latchReceiveTimes();
         }
         inc = writeMemory(ado, d.data()) ? 1 : 0;
@@ -181,7 +187,9 @@ bool Esc::readMemory(std::uint32_t address, Bytes out, bool orInto) {
 }
 
 bool Esc::writeMemory(std::uint32_t address, ConstBytes data) {
+  if (invalidFrame_) return writeUnshadowed(address, data);
   const std::uint32_t size = static_cast<std::uint32_t>(data.size());
+  if (smTriggerOnlyCount_ != 0) smTriggerOnlyWrite(address, size);
   const std::uint32_t memEnd = static_cast<std::uint32_t>(memory_.size());
   bool any = false;
   std::uint32_t at = address;
@@ -248,6 +256,11 @@ void Esc::countForwardedRxError(unsigned port) {
   if (port > 3) return;
   std::uint16_t at = reg::forwardedRxErrorCounter(port);
   if (memory_[at] < 0xFF) ++memory_[at];
+}
+
+void Esc::countProcessingUnitError() {
+  std::uint8_t& counter = memory_[reg::kEcatProcessingUnitErrorCounter.address];
+  if (counter < 0xFF) ++counter;
 }
 
 void Esc::countLostLink(unsigned port) {

@@ -206,7 +206,9 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
   std::uint8_t k = 0;
   notify(0, 0, frame, sendTime, true);
   SimTime t = sendTime + cableDelay(masterCable_);
-  bool bad = false;  // corrupted on the way (fault injection): counted, never executed
+  // Corrupted on the way (fault injection): counted, lost for the master, and processed by
+  // the ESCs behind the fault as an invalid frame (Esc::beginFrame).
+  bool bad = false;
   if (faults_ != nullptr) arriveWithFaults(0, 0, t, bad);
   stack_.push_back({0, 0, 0});
   arrival_[0][0] = t;
@@ -218,9 +220,9 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
   while (true) {
     if (k == 0) {
       slavesim::Esc& esc = *escs_[s];
-      esc.beginFrame();
+      esc.beginFrame(bad);
       if (record) route_.push_back({s, t - sendTime});
-      for (std::size_t i = 0; i < (bad ? 0 : count); ++i) {
+      for (std::size_t i = 0; i < count; ++i) {
         esc.processDatagram(datagrams_[i], t + leads[i]);
       }
       // Only a datagram of this frame can arm the latch; it completes once the frame is through.
