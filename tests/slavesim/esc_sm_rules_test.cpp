@@ -9,23 +9,14 @@
 // change SyncManager buffers.
 #include <gtest/gtest.h>
 
-#include "support/test_network.hpp"
+#include "support/esc_frames.hpp"
 
 namespace ecsim::testing {
 namespace {
 
-std::vector<std::uint8_t> smBytes(std::uint16_t start, std::uint16_t length, std::uint8_t control) {
-  std::vector<std::uint8_t> s(8, 0);
-  writeLe16(s, 0, start);
-  writeLe16(s, 2, length);
-  s[4] = control;
-  s[6] = 1;
-  return s;
-}
-
 constexpr std::uint8_t kOutputs3Buffer = 0x64;  // 3-buffer, ECAT write, watchdog trigger
 constexpr std::uint8_t kOutputs3BufferNoWd = 0x24;
-constexpr std::uint8_t kInputs3Buffer = 0x20;   // 3-buffer, ECAT read
+constexpr std::uint8_t kInputs3Buffer = 0x20;  // 3-buffer, ECAT read
 constexpr std::uint8_t kMailboxWrite = 0x26;
 constexpr std::uint8_t kMailboxRead = 0x22;
 
@@ -37,7 +28,8 @@ class SmRules : public ::testing::Test {
   }
   slavesim::Esc& esc() { return seg_.slave(0).esc(); }
   void configure(unsigned sm, std::uint16_t start, std::uint16_t length, std::uint8_t control) {
-    one(seg_, Command::kFpwr, phys(0x1001, reg::smChannel(sm)), smBytes(start, length, control));
+    one(seg_, Command::kFpwr, phys(0x1001, reg::smChannel(sm)),
+        smChannelBytes(start, length, control));
   }
   std::uint8_t smStatus(unsigned sm) {
     return one(seg_, Command::kFprd, phys(0x1001, reg::smChannel(sm) + reg::sm::kStatus.address),
@@ -179,40 +171,16 @@ TEST_F(SmRules, FreshlyActivatedThreeBufferSmReportsNoBufferWritten) {
 
 // Section I §14.1: with a frame error the processing unit discards "SyncManager buffer changes";
 // RAM is written. The corruption happens on the cable into the slave's port 0.
-struct CorruptOnce : topology::WireFaults {
-  bool armed{true};
-  bool corrupts(std::size_t s, unsigned port, SimTime) override {
-    const bool hit = armed && s == 0 && port == 0;
-    if (hit) armed = false;
-    return hit;
-  }
-  SimTime extraDelay(std::size_t, unsigned, SimTime) override { return 0; }
-};
-
-void sendCorrupted(topology::Segment& seg, const std::vector<DatagramSpec>& specs) {
-  CorruptOnce faults;
-  seg.setWireFaults(&faults);
-  std::array<std::uint8_t, kMaxFrameSize> buf{};
-  FrameBuilder b(
-      buf, EthernetHeader{kBroadcastMac, {1, 1, 1, 1, 1, 1}, std::nullopt, kEtherTypeEtherCat});
-  std::uint8_t idx = 0;
-  for (const auto& s : specs) ASSERT_TRUE(b.add(s.command, idx++, s.address, s.data).ok());
-  auto len = b.finish();
-  ASSERT_TRUE(len.ok());
-  EXPECT_FALSE(seg.processFrame(std::span(buf.data(), *len), 0).delivered)
-      << "a corrupted frame stays lost for the master";
-  seg.setWireFaults(nullptr);
-  seg.pollSlaves(0);
-}
-
 TEST_F(SmRules, InvalidFrameChangesNoSyncManagerState) {
   configure(1, 0x1080, 16, kMailboxRead);
   configure(2, 0x1100, 2, kOutputs3Buffer);
   ASSERT_TRUE(esc().pdiMailboxSend(std::vector<std::uint8_t>(16, 0x5A)));
   const std::uint8_t status2 = smStatus(2);
-  sendCorrupted(seg_, {{Command::kFprd, phys(0x1001, 0x1080), std::vector<std::uint8_t>(16)},
-                       {Command::kFpwr, phys(0x1001, 0x1100), {1, 2}},
-                       {Command::kFpwr, phys(0x1001, 0x1200), {3, 4}}});
+  EXPECT_FALSE(sendCorrupted(seg_, 0,
+                             {{Command::kFprd, phys(0x1001, 0x1080), std::vector<std::uint8_t>(16)},
+                              {Command::kFpwr, phys(0x1001, 0x1100), {1, 2}},
+                              {Command::kFpwr, phys(0x1001, 0x1200), {3, 4}}}))
+      << "a corrupted frame stays lost for the master";
   EXPECT_TRUE(esc().pdiMailboxResponsePending()) << "the read mailbox was not emptied";
   EXPECT_FALSE(esc().pdiOutputsReceived(2)) << "no buffer exchange";
   EXPECT_EQ(smStatus(2), status2);

@@ -7,22 +7,10 @@
 // 0x0000-0x0F7F; user RAM 0x0F80-0x0FFF is RAM (section I §17.3.1).
 #include <gtest/gtest.h>
 
-#include "support/test_network.hpp"
+#include "support/esc_frames.hpp"
 
 namespace ecsim::testing {
 namespace {
-
-// Corrupts the first frame that enters slave `victim` at port 0.
-struct CorruptAtEntry : topology::WireFaults {
-  std::size_t victim{0};
-  bool armed{true};
-  bool corrupts(std::size_t s, unsigned port, SimTime) override {
-    const bool hit = armed && s == victim && port == 0;
-    if (hit) armed = false;
-    return hit;
-  }
-  SimTime extraDelay(std::size_t, unsigned, SimTime) override { return 0; }
-};
 
 class InvalidFrame : public ::testing::Test {
  protected:
@@ -33,37 +21,21 @@ class InvalidFrame : public ::testing::Test {
           le16(static_cast<std::uint16_t>(0x1001 + i)));
     }
   }
-  // Sends one frame that is corrupted on the cable into slave `victim`; returns whether the
-  // master got it back.
-  bool sendCorrupted(std::size_t victim, const std::vector<DatagramSpec>& specs) {
-    CorruptAtEntry faults;
-    faults.victim = victim;
-    seg_.setWireFaults(&faults);
-    std::array<std::uint8_t, kMaxFrameSize> buf{};
-    FrameBuilder b(
-        buf, EthernetHeader{kBroadcastMac, {1, 1, 1, 1, 1, 1}, std::nullopt, kEtherTypeEtherCat});
-    std::uint8_t idx = 0;
-    for (const auto& s : specs) EXPECT_TRUE(b.add(s.command, idx++, s.address, s.data).ok());
-    auto len = b.finish();
-    EXPECT_TRUE(len.ok());
-    const bool delivered = seg_.processFrame(std::span(buf.data(), *len), 0).delivered;
-    seg_.setWireFaults(nullptr);
-    seg_.pollSlaves(0);
-    return delivered;
-  }
   slavesim::Esc& esc(std::size_t i) { return seg_.slave(i).esc(); }
   topology::Segment seg_;
 };
 
 TEST_F(InvalidFrame, RamWritesTakeEffectRegisterWritesDoNot) {
-  const bool delivered = sendCorrupted(
-      1, {{Command::kBwr, phys(0, reg::kUserRam.address), {0xA1}},
-          {Command::kBwr, phys(0, 0x1200), {0xB1, 0xB2}},
-          {Command::kBwr, phys(0, reg::kConfiguredStationAlias.address), {0x34, 0x12}},
-          {Command::kBwr, phys(0, reg::kAlControl.address), le16(0x0002)},
-          {Command::kFpwr, phys(0x1002, reg::kUserRam.address + 0x10), {0xC1}},
-          {Command::kApwr, phys(static_cast<std::uint16_t>(-2), reg::kUserRam.address + 0x20),
-           {0xD1}}});
+  const bool delivered =
+      sendCorrupted(seg_, 1,
+                    {{Command::kBwr, phys(0, reg::kUserRam.address), {0xA1}},
+                     {Command::kBwr, phys(0, 0x1200), {0xB1, 0xB2}},
+                     {Command::kBwr, phys(0, reg::kConfiguredStationAlias.address), {0x34, 0x12}},
+                     {Command::kBwr, phys(0, reg::kAlControl.address), le16(0x0002)},
+                     {Command::kFpwr, phys(0x1002, reg::kUserRam.address + 0x10), {0xC1}},
+                     {Command::kApwr,
+                      phys(static_cast<std::uint16_t>(-2), reg::kUserRam.address + 0x20),
+                      {0xD1}}});
   EXPECT_FALSE(delivered) << "the frame stays lost for the master";
   // Slave 0 saw a valid frame: everything happened there.
   EXPECT_EQ(esc(0).reg8(reg::kUserRam.address), 0xA1);
@@ -93,13 +65,14 @@ TEST_F(InvalidFrame, RamWritesTakeEffectRegisterWritesDoNot) {
 
 TEST_F(InvalidFrame, DcReceiveTimeLatchIsNotArmed) {
   // A write to 0x0900 is a register write: discarded, so no port receive times are latched.
-  sendCorrupted(0, {{Command::kBwr, phys(0, reg::kReceiveTimePort0.address), {0, 0, 0, 0}}});
+  EXPECT_FALSE(sendCorrupted(
+      seg_, 0, {{Command::kBwr, phys(0, reg::kReceiveTimePort0.address), {0, 0, 0, 0}}}));
   for (std::size_t i = 0; i < 3; ++i) {
     EXPECT_EQ(esc(i).read(reg::kReceiveTimeEcatProcessingUnit), 0u) << "slave " << i;
   }
 }
 
-TEST_F(InvalidFrame, LogicalWritesReachPlainRamOnly) {
+TEST_F(InvalidFrame, LogicalWritesReachPlainRam) {
   // FMMU: logical 0x100 (2 bytes) -> physical 0x1300 of slave 1 (plain RAM, no SM), type write.
   std::vector<std::uint8_t> fmmu(16, 0);
   writeLe32(fmmu, 0, 0x100);
@@ -109,7 +82,7 @@ TEST_F(InvalidFrame, LogicalWritesReachPlainRamOnly) {
   fmmu[11] = 2;
   fmmu[12] = 1;
   one(seg_, Command::kFpwr, phys(0x1002, reg::kFmmuBase), fmmu);
-  sendCorrupted(0, {{Command::kLwr, 0x100, {0x42, 0x43}}});
+  EXPECT_FALSE(sendCorrupted(seg_, 0, {{Command::kLwr, 0x100, {0x42, 0x43}}}));
   EXPECT_EQ(esc(1).reg8(0x1300), 0x42);
   EXPECT_EQ(esc(1).reg8(0x1301), 0x43);
 }
