@@ -198,8 +198,10 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
     return outcome;
   }
   // The walk, recording the route for the frames that follow (not with faults: they may delay).
+  // A walk with faults keeps the recorded route: clearing it while routeValid_ stays set made
+  // the next fault-free frame reach no ESC at all (WKC 0).
   const bool record = faults_ == nullptr;
-  route_.clear();
+  if (record) route_.clear();
   stack_.clear();
   for (auto& m : arrivalMask_) m = 0;
   std::uint32_t s = 0;
