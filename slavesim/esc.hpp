@@ -381,6 +381,11 @@ class Esc {
   std::uint8_t activeFmmuCount_{0};
   std::vector<std::uint8_t> scratch_;  // read-write and bit-FMMU staging, one datagram
   std::uint16_t lastWkcIncrement_{0};
+  // Per-frame state of the SM rules and invalid frames (below), next to lastWkcIncrement_ so
+  // a passing frame touches no extra cache line per ESC (sim_bench 1000 slaves: +15% without).
+  bool invalidFrame_{false};
+  std::uint8_t smTriggerOnlyCount_{0};
+  std::uint32_t smEndAccessed_{0};  // bit per SM: its end address was accessed in this frame
 
   // ---- SyncManager access rules and invalid frames (esc_sm.cpp; section I §8, §14.1) ----
   enum class SmAccess : std::uint8_t {
@@ -400,9 +405,6 @@ class Esc {
   };
   void smTriggerOnlyWrite(std::uint32_t address, std::uint32_t size);
   std::array<SmTriggerOnly, reg::kMaxSyncManagers> smTriggerOnly_{};
-  std::uint8_t smTriggerOnlyCount_{0};
-  std::uint32_t smEndAccessed_{0};  // bit per SM: its end address was accessed in this frame
-  bool invalidFrame_{false};
 };
 
 }  // namespace ecsim::slavesim
