@@ -118,8 +118,7 @@ bool StateChangeTask::step(SimTime now) {
           // AL status as written, so an acknowledge bit sent with the request comes back as
           // the error flag (a real EL1004: soem-sdinfo-ek1100-el1004.pcapng frames 289/293).
           // The state is reached; writing it once more without the bit clears the flag.
-          acks_.add().fpwr(slave.station, reg::kAlControl.address,
-                           alControl(static_cast<std::uint16_t>(target_)));
+          acks_.add().fpwr(slave.station, reg::kAlControl, static_cast<std::uint16_t>(target_));
           outcome_[position] = Outcome::kReached;
           slave.alStatus = static_cast<std::uint16_t>(slave.alStatus & ~kAlErrorFlag);
         } else if (slave.alError()) {

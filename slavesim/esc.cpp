@@ -35,6 +35,9 @@ void Esc::reset() {
   sync_ = {};
   activeFmmuCount_ = 0;
   smRangeCount_ = 0;
+  smTriggerOnlyCount_ = 0;
+  smEndAccessed_ = 0;
+  invalidFrame_ = false;
   lastMailboxResponseSize_ = 0;
   std::copy(regs_.reset.begin(), regs_.reset.end(), memory_.begin());  // table reset values
   // ESC information: what this ESC type is (section II 0x0000-0x0009).
@@ -106,7 +109,8 @@ void Esc::processDatagram(DatagramView d, SimTime time) {
       if (cmd == Command::kArmw || cmd == Command::kFrmw) {
         // Read at the addressed slave, write at every other one (datasheet Table 7).
         if (addressed) {
-          refreshVolatile(ado, static_cast<std::uint16_t>(std::min<std::uint32_t>(end, 0xFFFF)));
+          if (!invalidFrame_)  // register reads with side effects: discarded (section I §14.1)
+            refreshVolatile(ado, static_cast<std::uint16_t>(std::min<std::uint32_t>(end, 0xFFFF)));
           readMemory(ado, d.data(), false);
           inc = 1;
         } else if (writeMemory(ado, d.data())) {
@@ -118,7 +122,8 @@ void Esc::processDatagram(DatagramView d, SimTime time) {
       ++counters_.datagramsAddressed;
       CommandAccess access = commandAccess(cmd);
       if (access.read) {
-        refreshVolatile(ado, static_cast<std::uint16_t>(std::min<std::uint32_t>(end, 0xFFFF)));
+        if (!invalidFrame_)
+          refreshVolatile(ado, static_cast<std::uint16_t>(std::min<std::uint32_t>(end, 0xFFFF)));
         // Read-write commands: the data read is the memory before the write.
         if (access.write) {
           std::copy(d.data().begin(), d.data().end(), scratch_.begin());
@@ -175,7 +180,9 @@ bool Esc::readMemory(std::uint32_t address, Bytes out, bool orInto) {
 }
 
 bool Esc::writeMemory(std::uint32_t address, ConstBytes data) {
+  if (invalidFrame_) return writeUnshadowed(address, data);
   const std::uint32_t size = static_cast<std::uint32_t>(data.size());
+  if (smTriggerOnlyCount_ != 0) smTriggerOnlyWrite(address, size);
   const std::uint32_t memEnd = static_cast<std::uint32_t>(memory_.size());
   bool any = false;
   std::uint32_t at = address;
@@ -242,6 +249,11 @@ void Esc::countForwardedRxError(unsigned port) {
   if (port > 3) return;
   std::uint16_t at = reg::forwardedRxErrorCounter(port);
   if (memory_[at] < 0xFF) ++memory_[at];
+}
+
+void Esc::countProcessingUnitError() {
+  std::uint8_t& counter = memory_[reg::kEcatProcessingUnitErrorCounter.address];
+  if (counter < 0xFF) ++counter;
 }
 
 void Esc::countLostLink(unsigned port) {

@@ -70,14 +70,14 @@ void Esc::refreshEcatEvents() {
   const unsigned count = std::min<unsigned>(type_.syncManagers, ev::kMaxSmEvents);
   for (unsigned s = 0; s < count; ++s) {
     const std::uint16_t base = reg::smChannel(s);
-    const std::uint8_t control = memory_[base + reg::sm::kControl.address];
-    if ((control & reg::sm::kControlEcatEvent) == 0 ||
+    const SmControl control = SmControl::decode(memory_[base + reg::sm::kControl.address]);
+    if (!control.ecatEvent ||
         (memory_[base + reg::sm::kActivate.address] & reg::sm::kActivateEnable) == 0) {
       continue;
     }
     const std::uint8_t status = memory_[base + reg::sm::kStatus.address];
-    const std::uint8_t pending = isEcatWrite(control) ? reg::sm::kStatusInterruptRead
-                                 : isMailbox(control) ? reg::sm::kStatusMailboxFull
+    const std::uint8_t pending = control.isEcatWrite() ? reg::sm::kStatusInterruptRead
+                                 : control.isMailbox() ? reg::sm::kStatusMailboxFull
                                                       : reg::sm::kStatusInterruptWrite;
     if ((status & pending) != 0) request = static_cast<std::uint16_t>(request | (1u << (ev::kSmShift + s)));
   }

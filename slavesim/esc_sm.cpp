@@ -22,14 +22,78 @@ int Esc::smLookup(std::uint32_t at, std::uint32_t& limit) const {
 }
 
 void Esc::rebuildSmCache() {
+  std::uint32_t wasBuffer = 0;
+  for (std::uint8_t k = 0; k < smRangeCount_; ++k) wasBuffer |= 1u << smRanges_[k].index;
   smRangeCount_ = 0;
+  smTriggerOnlyCount_ = 0;
   for (unsigned s = 0; s < type_.syncManagers; ++s) {
     const SmConfig c = smConfig(s);
     if (!c.enabled || c.length == 0) continue;
+    if (c.length == 1) {
+      // Section II Table 90: "shall be greater 1, otherwise SyncManager is not activated. If
+      // set to 1, only Watchdog Trigger is generated if configured" (EL2004: 0x0F00, 1 byte).
+      smTriggerOnly_[smTriggerOnlyCount_++] = {c.start, static_cast<std::uint8_t>(s), c.control};
+      continue;
+    }
     smRanges_[smRangeCount_++] = {c.start, static_cast<std::uint32_t>(c.start) + c.length,
                                   static_cast<std::uint8_t>(s)};
     smCache_[s] = c;
+    if ((wasBuffer & (1u << s)) == 0 && !isMailbox(c.control)) {
+      // Freshly activated 3-buffer SM: status bits 5:4 "last written buffer" = 11, no buffer
+      // written yet (section II, SyncManager status register 0x0805+8n).
+      memory_[reg::smChannel(s) + reg::sm::kStatus.address] |= reg::sm::kStatusBufferMask;
+    }
   }
+}
+
+Esc::SmAccess Esc::smAccess(unsigned s, std::uint16_t address, std::size_t size) {
+  // Section I §8: "A buffer has to be accessed beginning with the start address, otherwise the
+  // access is denied. After accessing the start address, the whole buffer can be accessed [...]
+  // in several strokes. A buffer access finishes by accessing the end address [...]. The end
+  // address cannot be accessed twice inside a frame."
+  const SmConfig& cfg = smCache_[s];
+  SmState& st = sm_[s];
+  const std::uint32_t bit = 1u << s;
+  const bool atEnd = address + size == static_cast<std::size_t>(cfg.start) + cfg.length;
+  if (address != cfg.start && !st.open) return SmAccess::kDenied;
+  if (atEnd && (smEndAccessed_ & bit) != 0) return SmAccess::kDenied;
+  // An invalid frame changes no buffer state (section I §14.1).
+  if (invalidFrame_) return SmAccess::kInside;
+  if (!atEnd) {
+    st.open = true;
+    return SmAccess::kInside;
+  }
+  st.open = false;
+  smEndAccessed_ |= bit;
+  return SmAccess::kEnd;
+}
+
+void Esc::smTriggerOnlyWrite(std::uint32_t address, std::uint32_t size) {
+  for (std::uint8_t k = 0; k < smTriggerOnlyCount_; ++k) {
+    const SmTriggerOnly& t = smTriggerOnly_[k];
+    if (t.address < address || t.address >= address + size) continue;
+    if (t.control.watchdogTrigger) triggerPdWatchdog();
+    // For the firmware model: outputs have arrived (the ESM's SAFEOP->OP check).
+    if (isEcatWrite(t.control)) sm_[t.index].hasLatest = true;
+  }
+}
+
+bool Esc::writeUnshadowed(std::uint32_t address, ConstBytes data) {
+  // Section I §14.1: with a frame error "RAM areas will be written, because they do not have a
+  // shadow buffer for write data like registers"; registers are 0x0000-0x0F7F (user RAM
+  // 0x0F80-0x0FFF is RAM, section I §17.3.1). SyncManager buffers do not change.
+  const auto end = std::min<std::uint32_t>(address + static_cast<std::uint32_t>(data.size()),
+                                           static_cast<std::uint32_t>(memory_.size()));
+  bool any = false;
+  for (std::uint32_t at = std::max<std::uint32_t>(address, reg::kUserRam.address); at < end;) {
+    std::uint32_t limit = end;
+    if (smLookup(at, limit) < 0) {
+      std::copy_n(data.begin() + (at - address), limit - at, memory_.begin() + at);
+      any = true;
+    }
+    at = limit;
+  }
+  return any;
 }
 
 Esc::SmConfig Esc::smConfig(unsigned s) const {
@@ -61,11 +125,12 @@ bool Esc::readRam(std::uint16_t address, Bytes out, bool orInto, int smIndex) {
   const SmConfig& cfg = smCache_[s];  // smIndex comes from smLookup: the SM is cached
   SmState& st = sm_[s];
   const std::uint16_t base = reg::smChannel(s);
-  const bool lastByte = address + out.size() == static_cast<std::size_t>(cfg.start) + cfg.length;
   if (isMailbox(cfg.control)) {
     if (isEcatWrite(cfg.control) || !st.mailboxFull) return false;  // nothing to read
+    const SmAccess access = smAccess(s, address, out.size());
+    if (access == SmAccess::kDenied) return false;
     copyOut(&memory_[address]);
-    if (lastByte) {  // reading the last byte empties the mailbox
+    if (access == SmAccess::kEnd) {  // reading the last byte empties the mailbox
       st.mailboxFull = false;
       memory_[base + reg::sm::kStatus.address] &=
           static_cast<std::uint8_t>(~reg::sm::kStatusMailboxFull);
@@ -81,6 +146,7 @@ bool Esc::readRam(std::uint16_t address, Bytes out, bool orInto, int smIndex) {
     copyOut(&buffers_[bufBase + st.latest * cfg.length + offset]);
     return true;
   }
+  if (smAccess(s, address, out.size()) == SmAccess::kDenied) return false;
   copyOut(&buffers_[bufBase + st.latest * cfg.length + offset]);
   return true;
 }
@@ -94,16 +160,17 @@ bool Esc::writeRam(std::uint16_t address, ConstBytes data, int smIndex) {
   const SmConfig& cfg = smCache_[s];  // smIndex comes from smLookup: the SM is cached
   SmState& st = sm_[s];
   const std::uint16_t base = reg::smChannel(s);
-  const bool lastByte = address + data.size() == static_cast<std::size_t>(cfg.start) + cfg.length;
   if (isMailbox(cfg.control)) {
     if (!isEcatWrite(cfg.control)) return false;  // master may not write a read mailbox
     if (st.mailboxFull) {
       ++counters_.mailboxWritesRejected;
       return false;  // full: write refused, no WKC (the master retries)
     }
+    const SmAccess access = smAccess(s, address, data.size());
+    if (access == SmAccess::kDenied) return false;
     std::copy(data.begin(), data.end(), memory_.begin() + address);
     if (cfg.control.watchdogTrigger) triggerPdWatchdog();
-    if (lastByte) {
+    if (access == SmAccess::kEnd) {
       st.mailboxFull = true;
       st.hasLatest = true;  // for 1-buffer process data: outputs received
       memory_[base + reg::sm::kStatus.address] |= reg::sm::kStatusMailboxFull;
@@ -113,13 +180,15 @@ bool Esc::writeRam(std::uint16_t address, ConstBytes data, int smIndex) {
     return true;
   }
   if (!isEcatWrite(cfg.control)) return false;  // inputs: master writes are ignored
+  const SmAccess access = smAccess(s, address, data.size());
+  if (access == SmAccess::kDenied) return false;
   if (cfg.control.watchdogTrigger) triggerPdWatchdog();
   const std::size_t offset = static_cast<std::size_t>(address - cfg.start);
   const std::size_t bufBase = 3u * static_cast<std::size_t>(cfg.start);
   std::copy(
       data.begin(), data.end(),
       buffers_.begin() + static_cast<std::ptrdiff_t>(bufBase + st.writing * cfg.length + offset));
-  if (lastByte) {  // buffer complete: it becomes the newest, writing continues in a free one
+  if (access == SmAccess::kEnd) {  // buffer complete: it becomes the newest, writing goes on
     std::uint8_t done = st.writing;
     std::uint8_t next = 0;
     while (next == done || next == st.latest) ++next;
@@ -157,7 +226,7 @@ namespace {
 int findMailboxSm(const Esc& esc, unsigned count, bool ecatWrite) {
   for (unsigned s = 0; s < count; ++s) {
     auto c = esc.smConfig(s);
-    if (c.enabled && c.length > 0 && isMailbox(c.control) && isEcatWrite(c.control) == ecatWrite) {
+    if (c.enabled && c.length > 1 && isMailbox(c.control) && isEcatWrite(c.control) == ecatWrite) {
       return static_cast<int>(s);
     }
   }
@@ -225,8 +294,9 @@ ConstBytes Esc::pdiOutputs(unsigned s) const {
   if (s >= type_.syncManagers) return {};
   auto c = smConfig(s);
   if (!c.enabled || !isEcatWrite(c.control) || c.length == 0) return {};
-  // 1-buffer (mailbox-mode) process data: the buffer is the memory itself.
-  if (isMailbox(c.control)) return ConstBytes(memory_.data() + c.start, c.length);
+  // 1-buffer (mailbox-mode) process data, and an SM of length 1 (no buffer at all): the
+  // memory itself.
+  if (isMailbox(c.control) || c.length == 1) return ConstBytes(memory_.data() + c.start, c.length);
   const std::size_t bufBase = 3u * static_cast<std::size_t>(c.start);
   return ConstBytes(buffers_.data() + bufBase + sm_[s].latest * c.length, c.length);
 }
@@ -236,6 +306,10 @@ bool Esc::pdiWriteInputs(unsigned s, ConstBytes data) {
   auto c = smConfig(s);
   if (!c.enabled || isEcatWrite(c.control) || c.length == 0) return false;
   auto& st = sm_[s];
+  if (c.length == 1) {  // no buffer (section II Table 90): the PDI writes the memory itself
+    if (!data.empty()) memory_[c.start] = data[0];
+    return true;
+  }
   if (isMailbox(c.control)) {
     // 1-buffer inputs: the PDI may write only when the master has read the last buffer.
     if (st.mailboxFull) return false;
@@ -255,13 +329,15 @@ bool Esc::pdiWriteInputs(unsigned s, ConstBytes data) {
   st.latest = done;
   st.writing = next;
   st.hasLatest = true;
+  std::uint8_t& status = memory_[reg::smChannel(s) + reg::sm::kStatus.address];
+  status = static_cast<std::uint8_t>((status & ~reg::sm::kStatusBufferMask) | (done << 4));
   return true;
 }
 
 void Esc::pdiReleaseBuffer(unsigned s) {
   if (s >= type_.syncManagers) return;
   auto c = smConfig(s);
-  if (!c.enabled || !isMailbox(c.control) || !isEcatWrite(c.control)) return;
+  if (!c.enabled || c.length < 2 || !isMailbox(c.control) || !isEcatWrite(c.control)) return;
   sm_[s].mailboxFull = false;
   memory_[reg::smChannel(s) + reg::sm::kStatus.address] &=
       static_cast<std::uint8_t>(~reg::sm::kStatusMailboxFull);

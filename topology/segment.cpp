@@ -249,15 +249,19 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
     return outcome;
   }
   // The walk, recording the route for the frames that follow (not with faults: they may delay).
+  // A walk with faults keeps the recorded route: clearing it while routeValid_ stays set made
+  // the next fault-free frame reach no ESC at all (WKC 0).
   const bool record = faults_ == nullptr;
-  route_.clear();
+  if (record) route_.clear();
   stack_.clear();
   for (auto& m : arrivalMask_) m = 0;
   std::uint32_t s = 0;
   std::uint8_t k = 0;
   notify(0, 0, frame, sendTime, true);
   SimTime t = sendTime + cableDelay(masterCable_);
-  bool bad = false;  // corrupted on the way (fault injection): counted, never executed
+  // Corrupted on the way (fault injection): counted, lost for the master, and processed by
+  // the ESCs behind the fault as an invalid frame (Esc::beginFrame).
+  bool bad = false;
   bool lost = false;  // lost at a port by its loop setting (never returns to the master)
   if (faults_ != nullptr) arriveWithFaults(0, 0, t, bad);
   stack_.push_back({0, 0, 0});
@@ -270,9 +274,9 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
   while (true) {
     if (k == 0) {
       slavesim::Esc& esc = *escs_[s];
-      esc.beginFrame();
+      esc.beginFrame(bad);
       if (record) route_.push_back({s, t - sendTime});
-      for (std::size_t i = 0; i < (bad ? 0 : count); ++i) {
+      for (std::size_t i = 0; i < count; ++i) {
         esc.processDatagram(datagrams_[i], t + leads[i]);
       }
       // Only a datagram of this frame can arm the latch; it completes once the frame is through.
