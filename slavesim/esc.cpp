@@ -19,7 +19,7 @@ std::optional<EscType> escTypeByName(std::string_view name) {
 Esc::Esc(const EscType& type, std::vector<std::uint8_t> siiImage)
     : type_(type),
       memory_(kRamStart + static_cast<std::size_t>(type.ramKb) * 1024, 0),
-      writable_(ecatWriteMasks()),
+      regs_(escRegisterBytes()),
       buffers_(3 * (kRamStart + static_cast<std::size_t>(type.ramKb) * 1024), 0),
       sii_(std::move(siiImage)) {
   lastMailboxResponse_.resize(static_cast<std::size_t>(type.ramKb) * 1024);
@@ -36,6 +36,8 @@ void Esc::reset() {
   activeFmmuCount_ = 0;
   smRangeCount_ = 0;
   lastMailboxResponseSize_ = 0;
+  std::copy(regs_.reset.begin(), regs_.reset.end(), memory_.begin());  // table reset values
+  // ESC information: what this ESC type is (section II 0x0000-0x0009).
   memory_[reg::kType.address] = type_.typeRegister;
   memory_[reg::kRevision.address] = type_.revisionRegister;
   writeLe16(memory_, reg::kBuild.address, type_.build);
@@ -48,14 +50,6 @@ void Esc::reset() {
     ports = static_cast<std::uint8_t>(ports | (3u << (2 * p)));
   memory_[reg::kPortDescriptor.address] = ports;
   writeLe16(memory_, reg::kEscFeatures.address, type_.features);
-  writeLe16(memory_, reg::kAlStatus.address, 0x0001);  // INIT
-  writeLe16(memory_, reg::kAlControl.address, 0x0001);
-  writeLe16(memory_, reg::kWatchdogDivider.address, 0x09C2);  // 2498 -> 100 us (datasheet)
-  writeLe16(memory_, reg::kWatchdogTimePdi.address, 0x03E8);  // 1000 -> 100 ms
-  writeLe16(memory_, reg::kWatchdogTimeProcessData.address, 0x03E8);
-  writeLe16(memory_, reg::kSpeedCounterStart.address, 0x1000);
-  memory_[reg::kSystemTimeDifferenceFilterDepth.address] = 0x04;
-  memory_[reg::kSpeedCounterFilterDepth.address] = 0x0C;
   loadFromSii();
 }
 
@@ -133,9 +127,6 @@ void Esc::processDatagram(DatagramView d, SimTime time) {
           inc = readMemory(ado, d.data(), mode == AddressMode::kBroadcast) ? 1 : 0;
         }
       } else if (access.write) {
-        if (ado <= reg::kReceiveTimePort0.address && end > reg::kReceiveTimePort0.address) {
-          latchReceiveTimes();
-        }
         inc = writeMemory(ado, d.data()) ? 1 : 0;
       }
       break;

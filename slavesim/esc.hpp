@@ -19,6 +19,7 @@
 #include "protocol/registers.hpp"
 #include "protocol/time.hpp"
 #include "slavesim/dc_clock.hpp"
+#include "slavesim/esc_register_table.hpp"
 #include "slavesim/esc_type.hpp"
 
 namespace ecsim::slavesim {
@@ -247,8 +248,20 @@ class Esc {
   // Process RAM access for one contiguous piece inside one SM (sm >= 0) or outside any (-1).
   bool readRam(std::uint16_t address, Bytes out, bool orInto, int sm);
   bool writeRam(std::uint16_t address, ConstBytes data, int sm);
-  // Returns false when no byte of the range is writable for ECAT (no WKC then).
+  // ---- register file (esc_registers.cpp, rows in esc_register_table.cpp) ----
+  // Stores an ECAT write as the table's masks and byte rules say, then runs the write hooks of
+  // the rows it touched. Returns false when no byte of the range is writable for ECAT (no WKC).
   bool writeRegisters(std::uint16_t address, ConstBytes data);
+  void runWriteHook(WriteHook hook, std::uint32_t begin, std::uint32_t end, ConstBytes data,
+                    const std::array<bool, reg::kMaxSyncManagers>& smWasEnabled);
+  // The read hooks of the rows in [begin, end), as a bit set (bit n = ReadHook n).
+  std::uint32_t readHooks(std::uint32_t begin, std::uint32_t end) const;
+  // Firmware write of registers with the table's PDI write masks.
+  bool pdiWriteRegisters(std::uint16_t address, ConstBytes data);
+  bool smEnabledBit(unsigned s) const {
+    return (memory_[reg::smChannel(s) + reg::sm::kActivate.address] & reg::sm::kActivateEnable) !=
+           0;
+  }
   // [begin, end) overlapping 0x0910-0x0917 was written with `data` (starting at begin): one
   // step of the drift control loop, 0x092C updated.
   void systemTimeWritten(std::uint32_t begin, std::uint32_t end, ConstBytes data);
@@ -315,8 +328,8 @@ class Esc {
   SyncState sync_{};
 
   const EscType type_;
-  std::vector<std::uint8_t> memory_;  // registers 0x0000-0x0FFF + process RAM
-  const std::array<std::uint8_t, reg::kRegisterSpaceEnd>& writable_;  // ECAT write masks
+  std::vector<std::uint8_t> memory_;   // registers 0x0000-0x0FFF + process RAM
+  const RegisterBytes& regs_;          // the register table, per byte (shared by all ESCs)
   std::vector<std::uint8_t> buffers_;  // 3-buffer storage, 3 * length per buffered SM
   std::vector<std::uint8_t> sii_;
   std::array<SmState, reg::kMaxSyncManagers> sm_{};

@@ -28,7 +28,4 @@ inline bool isEcatWrite(std::uint8_t control) {
   return (control & reg::sm::kControlDirectionMask) == reg::sm::kControlDirectionWrite;
 }
 
-// ECAT write masks of the register space, one byte per register byte (esc_registers.cpp).
-const std::array<std::uint8_t, kRamStart>& ecatWriteMasks();
-
 }  // namespace ecsim::slavesim::esc_detail

@@ -144,8 +144,12 @@ bool Esc::writeRam(std::uint16_t address, ConstBytes data, int smIndex) {
 // ---- PDI side -------------------------------------------------------------------------------
 
 void Esc::pdiSetAlStatus(std::uint16_t status, std::uint16_t code) {
-  writeLe16(memory_, reg::kAlStatus.address, status);
-  writeLe16(memory_, reg::kAlStatusCode.address, code);
+  const std::array<std::uint8_t, 2> s{static_cast<std::uint8_t>(status),
+                                      static_cast<std::uint8_t>(status >> 8)};
+  const std::array<std::uint8_t, 2> c{static_cast<std::uint8_t>(code),
+                                      static_cast<std::uint8_t>(code >> 8)};
+  pdiWriteRegisters(reg::kAlStatus.address, s);
+  pdiWriteRegisters(reg::kAlStatusCode.address, c);
 }
 
 namespace {

@@ -1,0 +1,81 @@
+// The ESC's register behaviour as data: one row per register (or register block) of the
+// 0x0000-0x0FFF space with its ECAT and PDI write masks, reset value, how a write of its bytes
+// is stored, and the hooks that run when it is written or read (ESC datasheet section II, the
+// "ECAT"/"PDI" access columns and the register descriptions). Every access of the ECAT side
+// goes through it (esc_registers.cpp); a new register behaviour is a row and, where it has side
+// effects, a hook: not a new branch in the datagram path.
+//
+// Rows are expanded once into per-byte arrays (RegisterBytes) shared by every ESC: the tables
+// stay hot in the cache when a frame passes a thousand ESCs. Registers of FMMU/SM channels a
+// given ESC type does not have, and of a DC unit it lacks, are left to Esc::implemented().
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string_view>
+
+#include "protocol/registers.hpp"
+
+namespace ecsim::slavesim {
+
+// How an ECAT write stores a register byte (bits outside the ECAT write mask never change).
+enum class ByteRule : std::uint8_t {
+  kStore,          // masked merge of the written value
+  kClearOnWrite,   // a write of any value clears the byte (section II 0x030C-0x030F, 0x0442)
+  kClearRxErrors,  // a write to any byte of 0x0300-0x030B clears all twelve (section II 0x0300)
+  kClearLostLink,  // a write to any byte of 0x0310-0x0313 clears all four
+  kNoStore,        // the write has an effect (hook), the content does not change (0x0900)
+  kSmLocked,       // SM channel bytes 0-4: writable only while the SM is disabled (section II)
+};
+
+// Side effects of an ECAT write, run once per access after all bytes are stored, in this order.
+enum class WriteHook : std::uint8_t {
+  kNone,
+  kReceiveTimeLatch,   // 0x0900: latch the port receive times of this frame (section I §9.1.2)
+  kDlControl,          // 0x0100-0x0103: port loop settings may change
+  kAlControl,          // 0x0120: the firmware sees an AL control event (0x0220 bit 0)
+  kSiiCommand,         // 0x0503: execute the EEPROM command (section II 0x0502)
+  kSystemTime,         // 0x0910-0x0917: one step of the drift control loop, 0x092C
+  kSpeedCounterStart,  // 0x0930: reset of the drift control loop
+  kDcActivation,       // 0x0981: cyclic unit activation
+  kFmmu,               // 0x0600-0x06FF: rebuild the active FMMU cache
+  kSm,                 // 0x0800-0x087F: SM activation, repeat request, SM cache
+  kCount
+};
+
+// Refresh of volatile registers before an ECAT read of them.
+enum class ReadHook : std::uint8_t {
+  kNone,
+  kSystemTime,  // 0x0910: the local copy of the system time at this instant
+  kSyncUnit,    // 0x0980-0x09A7: cyclic unit status and next pulse times (esc_time_units.cpp)
+  kCount
+};
+
+struct RegisterRow {
+  std::uint16_t address;
+  std::uint16_t width;
+  std::uint8_t ecatWriteMask;  // per byte; 0 = read-only for the master
+  std::uint8_t pdiWriteMask;   // per byte; 0 = read-only for the firmware
+  std::uint64_t reset;         // little-endian, first min(width, 8) bytes; rest 0
+  ByteRule rule;
+  WriteHook write;
+  ReadHook read;
+  std::string_view name;
+};
+
+// The rows, in address order (non-overlapping; bytes not covered read as 0 and are read-only).
+std::span<const RegisterRow> escRegisterRows();
+
+// The rows expanded to one entry per register byte.
+struct RegisterBytes {
+  std::array<std::uint8_t, reg::kRegisterSpaceEnd> ecatWriteMask{};
+  std::array<std::uint8_t, reg::kRegisterSpaceEnd> pdiWriteMask{};
+  std::array<std::uint8_t, reg::kRegisterSpaceEnd> reset{};
+  std::array<ByteRule, reg::kRegisterSpaceEnd> rule{};
+  std::array<WriteHook, reg::kRegisterSpaceEnd> write{};
+  std::array<ReadHook, reg::kRegisterSpaceEnd> read{};
+};
+const RegisterBytes& escRegisterBytes();
+
+}  // namespace ecsim::slavesim
