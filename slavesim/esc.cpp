@@ -50,6 +50,7 @@ void Esc::reset() {
     ports = static_cast<std::uint8_t>(ports | (3u << (2 * p)));
   memory_[reg::kPortDescriptor.address] = ports;
   writeLe16(memory_, reg::kEscFeatures.address, type_.features);
+  miiReset();  // esc_mii.cpp
   loadFromSii();
 }
 

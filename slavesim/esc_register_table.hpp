@@ -27,6 +27,8 @@ enum class ByteRule : std::uint8_t {
   kClearLostLink,  // a write to any byte of 0x0310-0x0313 clears all four
   kNoStore,        // the write has an effect (hook), the content does not change (0x0900)
   kSmLocked,       // SM channel bytes 0-4: writable only while the SM is disabled (section II)
+  kSiiLocked,      // 0x0502-0x050F: not while the EEPROM interface is busy (esc_sii.cpp)
+  kMiiLocked,      // 0x0510-0x0515: not while MII management is busy or the PDI's (esc_mii.cpp)
 };
 
 // Side effects of an ECAT write, run once per access after all bytes are stored, in this order.
@@ -36,6 +38,7 @@ enum class WriteHook : std::uint8_t {
   kDlControl,          // 0x0100-0x0103: port loop settings may change
   kAlControl,          // 0x0120: the firmware sees an AL control event (0x0220 bit 0)
   kSiiCommand,         // 0x0503: execute the EEPROM command (section II 0x0502)
+  kMiiCommand,         // 0x0511: start an MII management command (section II 0x0510)
   kSystemTime,         // 0x0910-0x0917: one step of the drift control loop, 0x092C
   kSpeedCounterStart,  // 0x0930: reset of the drift control loop
   kDcActivation,       // 0x0981: cyclic unit activation
@@ -49,6 +52,8 @@ enum class ReadHook : std::uint8_t {
   kNone,
   kSystemTime,  // 0x0910: the local copy of the system time at this instant
   kSyncUnit,    // 0x0980-0x09A7: cyclic unit status and next pulse times (esc_time_units.cpp)
+  kSii,         // 0x0502-0x050F: a command whose busy time is over completes (esc_sii.cpp)
+  kMii,         // 0x0510-0x0515: likewise for MII management (esc_mii.cpp)
   kCount
 };
 

@@ -73,11 +73,13 @@ TEST_F(Mii, LinkStatusFollowsTheTopology) {
 }
 
 TEST_F(Mii, ReadIsBusyForOneMdioFrameWithTheCommandHeld) {
+  const SimTime first = now_;
   command(0x1001, reg::mii::kCommandRead, 0, reg::phy::kId1);
   EXPECT_EQ(control(0x1001) & (reg::mii::kBusy | reg::mii::kCommandMask),
             reg::mii::kBusy | reg::mii::kCommandRead);
+  now_ = first + 10 * kNsPerUs;
   command(0x1001, reg::mii::kCommandRead, 0, reg::phy::kId2);  // ignored while busy
-  now_ += kMdioFrame;
+  now_ = first + kMdioFrame + kNsPerUs;  // the first is done; a restarted one would not be
   EXPECT_EQ(control(0x1001) & (reg::mii::kBusy | reg::mii::kCommandMask | reg::mii::kErrorBits),
             0);
   EXPECT_EQ(readLe16(send(0x1001, Command::kFprd, reg::kPhyData.address, {0, 0}).data, 0), 0x2000)

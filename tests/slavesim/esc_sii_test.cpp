@@ -20,7 +20,7 @@ class SiiTiming : public ::testing::Test {
     seg_.addSlave(std::make_unique<slavesim::Slave>("s", type, makeSii(0x0000ABCD, 0x100),
                                                     slavesim::SlaveProfile{}));
     seg_.wireLine();
-    send(Command::kApwr, phys(0, reg::kConfiguredStationAddress.address), le16(kStation));
+    send(Command::kApwr, reg::kConfiguredStationAddress.address, le16(kStation));
   }
   DatagramResult send(Command c, std::uint16_t ado, std::vector<std::uint8_t> data) {
     auto r = one(seg_, c, phys(c == Command::kApwr ? 0 : kStation, ado), std::move(data), now_);
@@ -77,9 +77,10 @@ TEST_F(SiiTiming, BusyTimeIsAParameterOfTheEscType) {
 TEST_F(SiiTiming, CommandWrittenWhileBusyIsIgnored) {
   build(slavesim::kEt1100);
   command(reg::sii::kCommandRead, 0x08);
+  const SimTime first = commandAt_;
   at(100 * kNsPerUs);
   command(reg::sii::kCommandRead, 0x0A);  // product code: not taken, the interface is busy
-  at(slavesim::kEt1100.siiBusyNs);        // after the first command's busy time
+  now_ = first + slavesim::kEt1100.siiBusyNs + 10 * kNsPerUs;  // the first command's time is over
   EXPECT_EQ(status() & reg::sii::kBusy, 0) << "the second command did not restart busy";
   EXPECT_EQ(data32(), 0x0000ABCDu) << "the first command's data";
   EXPECT_EQ(readLe32(send(Command::kFprd, reg::kSiiAddress.address, {0, 0, 0, 0}).data, 0), 8u)

@@ -98,7 +98,9 @@ TEST(Replay, RealDcCaptureRunsToTheEndAgainstTheTerminalsSiiDumps) {
   }
   // What still differs is listed and explained in docs/fidelity.md; keep it from growing.
   EXPECT_EQ(report->wkcMismatches, 0u);
-  EXPECT_LE(report->dataMismatches, 609u);
+  // 319 = 312 EEPROM status polls (the real busy time varies per read, the model's is fixed)
+  // + 7 start-up AL status, ESC features and DL status (docs/fidelity.md).
+  EXPECT_LE(report->dataMismatches, 319u);
 }
 
 }  // namespace
