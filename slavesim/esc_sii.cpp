@@ -63,9 +63,10 @@ void Esc::loadFromSii() {
 }
 
 void Esc::siiCommand(std::uint16_t control) {
-  // While busy the interface takes no new command and keeps its address and data (section II
-  // 0x0502 bit 15; SOEM waits for busy to clear before every command, ecx_readeepromFP): the
-  // table's byte rule kSiiLocked refused the bytes, and the command is not started.
+  // While busy (section II 0x0502 bit 15) the interface takes no new command and keeps its
+  // address and data: the table's byte rule kSiiLocked refused the bytes and the command is not
+  // started. The datasheet says no more about writes during busy; masters never make them
+  // (SOEM waits for busy to clear before every command, ecx_readeepromFP).
   if (!siiAcceptsWrite()) return;
   std::uint16_t status = reg16(reg::kSiiControlStatus.address);
   status = static_cast<std::uint16_t>(
