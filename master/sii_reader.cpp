@@ -104,9 +104,13 @@ bool SiiReader::step(SimTime now) {
         retriesLeft_ = left;
         return true;
       }
-      datagram_.fprd(station_, reg::kSiiControlStatus.address, kStatusReadLength);
-      transport_.queue(datagram_);
       state_ = State::kStatus;
+      if (options_.busyPollInterval > 0) {
+        wakeAt_ = now + options_.busyPollInterval;  // the read takes the EEPROM a while
+      } else {
+        datagram_.fprd(station_, reg::kSiiControlStatus.address, kStatusReadLength);
+        transport_.queue(datagram_);
+      }
       return true;
     }
     case State::kStatus: {

@@ -3,8 +3,9 @@
 // machine:
 //
 //   FPWR 0x0502 {u16 read command, u32 word address}   the ESC starts the read
+//   (wait busyPollInterval)                            the EEPROM needs 0.5-0.8 ms
 //   FPRD 0x0502..0x050F                                status, address and 4 or 8 data bytes
-//     busy (0x0502 bit 15)       read again, up to `busyTimeout`
+//     busy (0x0502 bit 15)       wait busyPollInterval, read again, up to `busyTimeout`
 //     error bits (0x7800)        clear them with a NOP command and retry, `retries` times
 //
 // 0x0502 bit 6 tells whether a read yields 4 bytes (2 words) or 8 (4 words). The reader takes
@@ -26,7 +27,12 @@ namespace ecsim::master {
 struct SiiReaderOptions {
   SimTime busyTimeout{20 * kNsPerMs};  // SOEM's EC_TIMEOUTEEP
   unsigned retries{3};                 // SOEM's EC_DEFAULTRETRIES
-  SimTime busyPollInterval{0};         // 0: read the status again at once
+  // Wait between the command and the first status read and between status reads while busy
+  // (SOEM's EC_LOCALDELAY, 200 us, in ecx_readeepromFP/ecx_eeprom_waitnotbusyFP); a real
+  // EEPROM is busy 530-796 us per read (../shared/pcap/replay-dc.pcapng frames 104-110), so
+  // polling at once would only send frames. The wait is on the bus's clock: virtual time
+  // passes while it lasts. 0: read the status again at once.
+  SimTime busyPollInterval{200 * kNsPerUs};
 };
 
 class SiiReader final : public Task {

@@ -54,6 +54,7 @@ void Esc::reset() {
   memory_[reg::kPortDescriptor.address] = ports;
   writeLe16(memory_, reg::kEscFeatures.address, type_.features);
   resetEventState();  // AL control mailbox, ECAT event state (esc_events.cpp)
+  miiReset();  // esc_mii.cpp
   loadFromSii();
 }
 

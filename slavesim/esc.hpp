@@ -292,7 +292,18 @@ class Esc {
   // step of the drift control loop, 0x092C updated.
   void systemTimeWritten(std::uint32_t begin, std::uint32_t end, ConstBytes data);
   void refreshVolatile(std::uint16_t begin, std::uint16_t end);
+  // ---- SII EEPROM interface timing (esc_sii.cpp, issue #15 item 7) ----------------------
+  // A command written to 0x0503 starts it (busy, command bits held); it takes effect when
+  // the device's busy time (EscType::siiBusyNs) has passed. siiRefresh() completes it once
+  // the ESC's time (now_) is past that: the table's read hook and byte rule for 0x0502-0x050F
+  // call it, so a read sees the result and a write is refused only while still busy.
   void siiCommand(std::uint16_t control);
+  void siiRefresh();
+  bool siiAcceptsWrite() {
+    siiRefresh();
+    return !siiPending_;
+  }
+  void siiExecute(std::uint16_t command, std::uint32_t word, std::uint16_t data);
   void smActivationChanged(unsigned sm);
   // The enabled SM covering `at` (or -1); lowers `limit` to where that SM, or the next SM
   // above `at`, ends or starts, so callers split accesses at SM boundaries.
@@ -362,6 +373,37 @@ class Esc {
   std::vector<std::uint8_t> lastMailboxResponse_;
   std::size_t lastMailboxResponseSize_{0};
   bool latchArmed_{false};
+  // SII EEPROM command in progress (esc_sii.cpp): what runs and when it is done.
+  bool siiPending_{false};
+  std::uint16_t siiPendingCommand_{0};
+  std::uint16_t siiPendingData_{0};
+  std::uint32_t siiPendingWord_{0};
+  SimTime siiDoneAt_{0};
+
+  // ---- MII management interface and PHY model (esc_mii.cpp, issue #15 item 8) -----------
+  // One IEEE 802.3 clause 22 PHY per MII port, at PHY address (0x0510[7:3] + port).
+  struct PhyState {
+    std::uint16_t control{0};
+    std::uint16_t advertisement{0};
+  };
+  void miiReset();
+  // Command byte 0x0511 written (table write hook): start a read or write of a PHY register.
+  void miiCommand();
+  // Byte rule of 0x0510-0x0515: ECAT writes are refused while a command runs or while the PDI
+  // has the interface (0x0517 bit 0).
+  bool miiAcceptsEcatWrite();
+  // Completes a running MII command once the ESC's time is past its end.
+  void miiRefresh();
+  bool phyPresent(std::uint8_t phyAddress, unsigned& port) const;
+  std::uint16_t phyRead(unsigned port, std::uint8_t index) const;
+  void phyWrite(unsigned port, std::uint8_t index, std::uint16_t value);
+  std::array<PhyState, 4> phys_{};
+  bool miiPending_{false};
+  std::uint16_t miiPendingCommand_{0};
+  std::uint8_t miiPendingPhy_{0};
+  std::uint8_t miiPendingRegister_{0};
+  std::uint16_t miiPendingData_{0};
+  SimTime miiDoneAt_{0};
   DcUnit dcUnit_{DcUnit::kFull};
   DcClock dc_;
   SimTime now_{0};       // simulation time of the datagram being processed

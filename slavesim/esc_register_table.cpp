@@ -76,13 +76,25 @@ std::vector<RegisterRow> buildRows() {
       // SII EEPROM interface (the PDI columns apply while the PDI owns the EEPROM, 0x0500)
       row(kSiiConfiguration, 0x03, kNone),
       row(kSiiPdiAccessState, kNone, 0x01),
-      block(kSiiControlStatus.address, 1, 0x01, 0x01, "EEPROM Control/Status (write enable)"),
+      // While a command runs (busy, 0x0502 bit 15) the master cannot change control, address
+      // or data (kSiiLocked); reads complete a command whose time is over (esc_sii.cpp).
+      block(kSiiControlStatus.address, 1, 0x01, 0x01, "EEPROM Control/Status (write enable)",
+            WriteHook::kNone, ByteRule::kSiiLocked, ReadHook::kSii),
       block(kSiiControlStatus.address + 1, 1, 0x07, 0x07, "EEPROM Control/Status (command)",
-            WriteHook::kSiiCommand),
-      row(kSiiAddress, kAll, kAll),
-      block(kSiiData.address, kSiiData.width, kAll, kAll, kSiiData.name),
-      // MII management interface
-      block(kMiiControlStatus.address, 6, kAll, kAll, "MII Management"),
+            WriteHook::kSiiCommand, ByteRule::kSiiLocked, ReadHook::kSii),
+      row(kSiiAddress, kAll, kAll, 0, WriteHook::kNone, ByteRule::kSiiLocked, ReadHook::kSii),
+      block(kSiiData.address, kSiiData.width, kAll, kAll, kSiiData.name, WriteHook::kNone,
+            ByteRule::kSiiLocked, ReadHook::kSii),
+      // MII management interface (esc_mii.cpp): write enable (bit 0) and command (bits 8-9)
+      // for the master, the rest of 0x0510 is the ESC's; PHY and register address 5 bits each.
+      // Refused while busy or while the PDI has the interface (kMiiLocked).
+      block(kMiiControlStatus.address, 1, 0x01, kAll, "MII Control/Status (write enable)",
+            WriteHook::kNone, ByteRule::kMiiLocked, ReadHook::kMii),
+      block(kMiiControlStatus.address + 1, 1, 0x03, kAll, "MII Control/Status (command)",
+            WriteHook::kMiiCommand, ByteRule::kMiiLocked, ReadHook::kMii),
+      row(kPhyAddress, 0x1F, kAll, 0, WriteHook::kNone, ByteRule::kMiiLocked),
+      row(kPhyRegisterAddress, 0x1F, kAll, 0, WriteHook::kNone, ByteRule::kMiiLocked),
+      row(kPhyData, kAll, kAll, 0, WriteHook::kNone, ByteRule::kMiiLocked, ReadHook::kMii),
       row(kMiiEcatAccessState, 0x01, kNone),
       row(kMiiPdiAccessState, kNone, 0x01),
   };

@@ -29,6 +29,8 @@ enum class ByteRule : std::uint8_t {
   kSmLocked,       // SM channel bytes 0-4: writable only while the SM is disabled (section II)
   kAlControlMailbox,  // 0x0120: without device emulation refused (no WKC) until the PDI read
                       // the last value (section II 0x0120 note; Esc::ecatAlControlWritable)
+  kSiiLocked,      // 0x0502-0x050F: not while the EEPROM interface is busy (esc_sii.cpp)
+  kMiiLocked,      // 0x0510-0x0515: not while MII management is busy or the PDI's (esc_mii.cpp)
 };
 
 // Side effects of an ECAT write, run once per access after all bytes are stored, in this order.
@@ -40,6 +42,7 @@ enum class WriteHook : std::uint8_t {
                        // into AL status (esc_events.cpp)
   kEcatEventMask,      // 0x0200: which ECAT events go into the datagrams' IRQ field
   kSiiCommand,         // 0x0503: execute the EEPROM command (section II 0x0502)
+  kMiiCommand,         // 0x0511: start an MII management command (section II 0x0510)
   kSystemTime,         // 0x0910-0x0917: one step of the drift control loop, 0x092C
   kSpeedCounterStart,  // 0x0930: reset of the drift control loop
   kDcActivation,       // 0x0981: cyclic unit activation
@@ -57,6 +60,8 @@ enum class ReadHook : std::uint8_t {
   // Clear-on-read, after the read (Esc::afterRegisterRead): the ECAT event bit of the register.
   kDlStatusEvent,  // 0x0110: clears 0x0210 bit 2
   kAlStatusEvent,  // 0x0130: clears 0x0210 bit 3
+  kSii,         // 0x0502-0x050F: a command whose busy time is over completes (esc_sii.cpp)
+  kMii,         // 0x0510-0x0515: likewise for MII management (esc_mii.cpp)
   kCount
 };
 

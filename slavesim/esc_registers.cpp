@@ -97,6 +97,14 @@ bool Esc::writeRegisters(std::uint16_t address, ConstBytes data) {
         break;
       case ByteRule::kNoStore:
         break;
+      case ByteRule::kSiiLocked:
+        if (!siiAcceptsWrite()) break;
+        memory_[a] = static_cast<std::uint8_t>((memory_[a] & ~mask) | (data[i] & mask));
+        break;
+      case ByteRule::kMiiLocked:
+        if (!miiAcceptsEcatWrite()) break;
+        memory_[a] = static_cast<std::uint8_t>((memory_[a] & ~mask) | (data[i] & mask));
+        break;
       case ByteRule::kSmLocked: {
         // Bytes 0-4 of a channel precede its activate byte, so the enable bit read here is
         // still the one before this write.
@@ -139,6 +147,9 @@ void Esc::runWriteHook(WriteHook hook, std::uint32_t begin, std::uint32_t end, C
     case WriteHook::kSiiCommand:
       // The command byte was written: execute it (write needs the enable bit in the same access).
       siiCommand(read(reg::kSiiControlStatus));
+      break;
+    case WriteHook::kMiiCommand:
+      miiCommand();
       break;
     case WriteHook::kSystemTime:
       systemTimeWritten(begin, end, data);
@@ -185,6 +196,8 @@ void Esc::refreshVolatile(std::uint16_t begin, std::uint16_t end) {
   if ((hooks & (1u << static_cast<unsigned>(ReadHook::kEcatEventRequest))) != 0) {
     refreshEcatEvents();
   }
+  if ((hooks & (1u << static_cast<unsigned>(ReadHook::kSii))) != 0) siiRefresh();
+  if ((hooks & (1u << static_cast<unsigned>(ReadHook::kMii))) != 0) miiRefresh();
   if ((hooks & (1u << static_cast<unsigned>(ReadHook::kSystemTime))) != 0) {
     writeLe64(memory_, reg::kSystemTime.address,
               static_cast<std::uint64_t>(wrapAdd(localNow_, read(reg::kSystemTimeOffset))));
@@ -229,12 +242,18 @@ void Esc::completeReceiveTimeLatch(const std::array<SimTime, 4>& times, std::uin
       writeLe32(memory_, reg::receiveTime(p), static_cast<std::uint32_t>(dc_.localTime(times[p])));
     }
   }
+  // 0x0918 latches when the frame's first bit reaches the processing unit, which a frame
+  // enters from port 0: the same instant as port 0's receive time, wherever in the frame the
+  // latching write was. Real EK1100 and EL2889 show both equal (../shared/pcap/replay-dc.pcapng
+  // frames 504/506 and 512/514; soem-sdinfo-ek1100-el1004.pcapng frames 453/455).
+  if ((portMask & 0x01) != 0) {
+    writeLe64(memory_, reg::kReceiveTimeEcatProcessingUnit.address,
+              static_cast<std::uint64_t>(dc_.localTime(times[0])));
+  }
 }
 
 void Esc::latchReceiveTimes() {
-  latchArmed_ = true;
-  writeLe64(memory_, reg::kReceiveTimeEcatProcessingUnit.address,
-            static_cast<std::uint64_t>(localNow_));
+  latchArmed_ = true;  // 0x0900-0x090F and 0x0918 are written once the frame has passed
   events_.dcLatched = true;
 }
 

@@ -39,6 +39,7 @@ std::uint16_t siiWord(const std::vector<std::uint8_t>& sii, std::size_t word) {
 }  // namespace
 
 void Esc::loadFromSii() {
+  siiPending_ = false;  // power-on or reload: no command in progress
   std::uint16_t status = type_.siiRead8Bytes ? reg::sii::kReadSize8Bytes : 0;
   if (sii_.size() > 2048) status |= reg::sii::kTwoAddressBytes;  // > 16 kbit
   std::uint16_t dl = reg16(reg::kDlStatus.address);
@@ -62,34 +63,75 @@ void Esc::loadFromSii() {
 }
 
 void Esc::siiCommand(std::uint16_t control) {
+  // While busy (section II 0x0502 bit 15) the interface takes no new command and keeps its
+  // address and data: the table's byte rule kSiiLocked refused the bytes and the command is not
+  // started. The datasheet says no more about writes during busy; masters never make them
+  // (SOEM waits for busy to clear before every command, ecx_readeepromFP).
+  if (!siiAcceptsWrite()) return;
   std::uint16_t status = reg16(reg::kSiiControlStatus.address);
   status = static_cast<std::uint16_t>(
       status & ~(reg::sii::kCommandMask | reg::sii::kBusy | reg::sii::kWriteEnable));
   const std::uint16_t command = control & reg::sii::kCommandMask;
-  const std::uint32_t word = reg32(reg::kSiiAddress.address);
-  const std::size_t words = sii_.size() / 2;
   switch (command) {
     case reg::sii::kCommandNop:
       // A NOP clears the error bits (datasheet section II, 0x0502 description).
       status = static_cast<std::uint16_t>(status &
                                           ~(reg::sii::kCommandError | reg::sii::kWriteEnableError));
       break;
+    case reg::sii::kCommandWrite:
+      if ((control & reg::sii::kWriteEnable) == 0) {
+        status |= reg::sii::kWriteEnableError;  // refused at once, the EEPROM is not accessed
+        break;
+      }
+      [[fallthrough]];
+    case reg::sii::kCommandRead:
+    case reg::sii::kCommandReload:
+      // The I2C transfer runs: busy with the command bits held until it is done (a real
+      // EK1100 answers 0x8140 while reading: ../shared/pcap/replay-dc.pcapng frames 106, 108,
+      // then 0x0040 in frame 110). Address and data are taken now.
+      siiPending_ = true;
+      siiPendingCommand_ = command;
+      siiPendingWord_ = reg32(reg::kSiiAddress.address);
+      siiPendingData_ = reg16(reg::kSiiData.address);
+      siiDoneAt_ = now_ + static_cast<SimTime>(type_.siiBusyNs);
+      status = static_cast<std::uint16_t>(status | reg::sii::kBusy | command);
+      break;
+    default:
+      status |= reg::sii::kCommandError;  // two command bits at once: invalid
+      break;
+  }
+  writeLe16(memory_, reg::kSiiControlStatus.address, status);
+}
+
+void Esc::siiRefresh() {
+  if (!siiPending_ || now_ < siiDoneAt_) return;
+  siiPending_ = false;
+  siiExecute(siiPendingCommand_, siiPendingWord_, siiPendingData_);
+}
+
+void Esc::siiExecute(std::uint16_t command, std::uint32_t word, std::uint16_t data) {
+  std::uint16_t status = static_cast<std::uint16_t>(
+      reg16(reg::kSiiControlStatus.address) & ~(reg::sii::kCommandMask | reg::sii::kBusy));
+  // An I2C EEPROM ignores the address bits above its size, so addresses beyond the end wrap
+  // around to its start (section I §11.3.3.2: the wrap-around is the application's business,
+  // the ESC knows nothing of it). The image is the EEPROM: its size is the device's.
+  const std::size_t words = sii_.size() / 2;
+  switch (command) {
     case reg::sii::kCommandRead: {
       const unsigned count = type_.siiRead8Bytes ? 4 : 2;
       for (unsigned i = 0; i < count; ++i) {
-        std::uint16_t value = (word + i < words) ? siiWord(sii_, word + i) : 0xFFFF;
+        const std::uint16_t value =
+            words == 0 ? 0xFFFF : siiWord(sii_, (static_cast<std::size_t>(word) + i) % words);
         writeLe16(memory_, static_cast<std::uint16_t>(reg::kSiiData.address + 2 * i), value);
       }
       status = static_cast<std::uint16_t>(status & ~reg::sii::kCommandError);
       break;
     }
     case reg::sii::kCommandWrite:
-      if ((control & reg::sii::kWriteEnable) == 0) {
-        status |= reg::sii::kWriteEnableError;
-      } else if (word < words) {
-        writeLe16(sii_, 2 * word, reg16(reg::kSiiData.address));
+      if (words == 0) {
+        status |= reg::sii::kCommandError;  // no EEPROM: no acknowledge
       } else {
-        status |= reg::sii::kCommandError;
+        writeLe16(sii_, 2 * (word % words), data);
       }
       break;
     case reg::sii::kCommandReload:
@@ -98,7 +140,6 @@ void Esc::siiCommand(std::uint16_t control) {
       events_.eepromReloaded = true;
       break;
     default:
-      status |= reg::sii::kCommandError;  // two command bits at once: invalid
       break;
   }
   writeLe16(memory_, reg::kSiiControlStatus.address, status);

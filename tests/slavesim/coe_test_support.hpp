@@ -43,17 +43,32 @@ inline std::vector<std::uint8_t> fmmuRegisterBytes(std::uint32_t logical, std::u
   return f;
 }
 
-// Reads the SII of the slave at `station` through 0x0502/0x0504/0x0508, category by category.
+// Reads the SII of the slave at `station` through 0x0502/0x0504/0x0508, category by category,
+// as a master does: each read command keeps the EEPROM busy for a while (0x0502 bit 15; 0.53-
+// 0.80 ms on a real EK1100, ../shared/pcap/replay-dc.pcapng frames 104-110), so the status is
+// polled every 100 us of simulated time from `start` on until busy clears, then the data read.
+// The firmware does not run meanwhile (the ESC alone serves the EEPROM), so callers may go on
+// at their own time afterwards.
 inline std::vector<std::uint8_t> readSiiThroughFrames(topology::Segment& seg,
-                                                      std::uint16_t station) {
+                                                      std::uint16_t station, SimTime start = 0) {
   std::vector<std::uint8_t> bytes;
+  SimTime t = start;
+  auto escOnly = [&](Command c, std::uint16_t ado, std::vector<std::uint8_t> data) {
+    auto r = exchange(seg, {{c, phys(station, ado), std::move(data)}}, t, false).at(0);
+    t += 100 * kNsPerUs;
+    return r;
+  };
   auto readWords = [&](std::uint32_t word, std::size_t count) {
     while (count > 0) {
       std::vector<std::uint8_t> cmd(6, 0);
       writeLe16(cmd, 0, reg::sii::kCommandRead);
       writeLe32(cmd, 2, word);
-      one(seg, Command::kFpwr, phys(station, reg::kSiiControlStatus.address), cmd);
-      auto data = one(seg, Command::kFprd, phys(station, reg::kSiiData.address), {0, 0, 0, 0});
+      escOnly(Command::kFpwr, reg::kSiiControlStatus.address, cmd);
+      for (int poll = 0; poll < 100; ++poll) {
+        auto status = escOnly(Command::kFprd, reg::kSiiControlStatus.address, {0, 0});
+        if ((readLe16(status.data, 0) & reg::sii::kBusy) == 0) break;
+      }
+      auto data = escOnly(Command::kFprd, reg::kSiiData.address, {0, 0, 0, 0});
       for (std::size_t i = 0; i < 2 && count > 0; ++i, --count, ++word) {
         if (bytes.size() < 2 * (word + 1)) bytes.resize(2 * (word + 1), 0xFF);
         bytes[2 * word] = data.data[2 * i];

@@ -164,7 +164,7 @@ inline OpSlave bringToOp(topology::Segment& seg, const std::vector<ProcessDataSm
     return one(seg, c, address, std::move(data), now);
   };
   at(Command::kApwr, phys(0, reg::kConfiguredStationAddress.address), le16(kStation));
-  auto image = SiiImage::parseLenient(readSiiThroughFrames(seg, kStation));
+  auto image = SiiImage::parseLenient(readSiiThroughFrames(seg, kStation, now));
   EXPECT_TRUE(image.ok());
   if (!image.ok()) return out;
   const SiiContents& sii = image->contents();

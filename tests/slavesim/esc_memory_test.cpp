@@ -176,16 +176,20 @@ TEST_F(Memory, SmRegistersLockedWhileEnabled) {
 
 TEST_F(Memory, SiiReadLoadsFourWordsPerCommand) {
   // Read command for word 0x0008 (vendor id), then the data register.
+  // The EEPROM is busy for a while after the command (esc_sii_test.cpp): look after 1 ms.
   one(seg_, Command::kFpwr, phys(0x1001, 0x0502), {0x00, 0x01, 0x08, 0x00, 0x00, 0x00});
-  auto status = one(seg_, Command::kFprd, phys(0x1001, 0x0502), {0, 0});
+  auto status = one(seg_, Command::kFprd, phys(0x1001, 0x0502), {0, 0}, kNsPerMs);
   EXPECT_EQ(readLe16(status.data, 0) & 0x8000, 0) << "not busy";
   EXPECT_EQ(readLe16(status.data, 0) & 0x0040, 0x0040)
       << "ET1100 reads 8 bytes, as a real EK1100 reports (replay-dc.pcapng frame 102)";
-  auto data = one(seg_, Command::kFprd, phys(0x1001, 0x0508), std::vector<std::uint8_t>(8, 0));
+  auto data = one(seg_, Command::kFprd, phys(0x1001, 0x0508), std::vector<std::uint8_t>(8, 0),
+                  kNsPerMs);
   EXPECT_EQ(readLe32(data.data, 0), 0x0000ABCDu) << "word 8-9: vendor";
   EXPECT_EQ(readLe32(data.data, 4), 0x00000100u) << "word A-B: product of slave 0";
-  one(seg_, Command::kFpwr, phys(0x1002, 0x0502), {0x00, 0x01, 0x0A, 0x00, 0x00, 0x00});
-  EXPECT_EQ(readLe32(one(seg_, Command::kFprd, phys(0x1002, 0x0508), {0, 0, 0, 0}).data, 0),
+  one(seg_, Command::kFpwr, phys(0x1002, 0x0502), {0x00, 0x01, 0x0A, 0x00, 0x00, 0x00}, kNsPerMs);
+  EXPECT_EQ(readLe32(one(seg_, Command::kFprd, phys(0x1002, 0x0508), {0, 0, 0, 0}, 2 * kNsPerMs)
+                         .data,
+                     0),
             0x101u);
 }
 
@@ -197,6 +201,7 @@ TEST_F(Memory, SiiWriteNeedsWriteEnable) {
   EXPECT_EQ(esc(0).reg16(0x0502) & 0x7800, 0);
   cmd[0] = 0x01;
   one(seg_, Command::kFpwr, phys(0x1001, 0x0502), cmd);
+  one(seg_, Command::kFprd, phys(0x1001, 0x0502), {0, 0}, kNsPerMs);  // after the busy time
   EXPECT_EQ(esc(0).sii()[0x80], 0x34);
   EXPECT_EQ(esc(0).sii()[0x81], 0x12);
 }

@@ -107,10 +107,10 @@ struct DatagramResult {
 };
 
 // Sends one frame with the given datagrams through the segment, runs the slaves' firmware
-// and returns each datagram as it came back.
+// (unless `firmware` is false: ESC only) and returns each datagram as it came back.
 inline std::vector<DatagramResult> exchange(topology::Segment& seg,
                                             const std::vector<DatagramSpec>& specs,
-                                            SimTime now = 0) {
+                                            SimTime now = 0, bool firmware = true) {
   std::array<std::uint8_t, kMaxFrameSize> buf{};
   FrameBuilder b(
       buf, EthernetHeader{kBroadcastMac, {1, 1, 1, 1, 1, 1}, std::nullopt, kEtherTypeEtherCat});
@@ -123,7 +123,7 @@ inline std::vector<DatagramResult> exchange(topology::Segment& seg,
   EXPECT_TRUE(len.ok());
   auto outcome = seg.processFrame(std::span(buf.data(), *len), now);
   EXPECT_TRUE(outcome.delivered);
-  seg.pollSlaves(now);
+  if (firmware) seg.pollSlaves(now);
   std::vector<DatagramResult> out;
   auto frame = EtherCatFrame::parse(std::span(buf.data(), *len));
   EXPECT_TRUE(frame.ok());

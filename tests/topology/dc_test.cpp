@@ -152,5 +152,35 @@ TEST_F(Dc, WithoutDistributionTheClocksDriftApart) {
       << "static compensation alone only fixes the rate approximately";
 }
 
+// 0x0918 (receive time at the ECAT processing unit) latches the instant the frame's first bit
+// reaches the processing unit, which for a frame entering at port 0 is port 0's receive time
+// in 0x0900 — not the time the 0x0900 write datagram itself passes. Real hardware shows the
+// two equal: EK1100 0x0900 = 0x3C620F52 and 0x0918 low half = 0x3C620F52, EL2889 0x3C8065EC
+// both (../shared/pcap/replay-dc.pcapng frames 504/506 and 512/514, EtherCrab's single-datagram
+// BWR 0x0900 in frame 501); EK1100 0xE551613A both (soem-sdinfo-ek1100-el1004.pcapng frames
+// 453/455, SOEM's BWR in frame 450).
+TEST_F(Dc, EpuReceiveTimeIsTheFrameStartLikePort0) {
+  buildLine(seg_, 3);
+  for (std::size_t i = 0; i < 3; ++i) seg_.setClock(i, static_cast<SimTime>(i) * 777'777, 0.0);
+  assign(3);
+  // The latching write behind a 64-byte datagram, as a master batching it would send it.
+  exchange(seg_,
+           {{Command::kBrd, phys(0, 0x0F80), std::vector<std::uint8_t>(64, 0)},
+            {Command::kBwr, phys(0, 0x0900), {0, 0, 0, 0}}},
+           now_);
+  now_ += 50'000;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const std::uint32_t port0 = rd32(i, 0x0900);
+    const std::uint64_t epu = rd64(i, 0x0918);
+    EXPECT_EQ(static_cast<std::uint32_t>(epu), port0) << "slave " << i;
+  }
+  // A lone BWR as SOEM and EtherCrab send it: the datagram starts 10 bytes into the frame.
+  one(seg_, Command::kBwr, phys(0, 0x0900), {0, 0, 0, 0}, now_);
+  now_ += 50'000;
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(static_cast<std::uint32_t>(rd64(i, 0x0918)), rd32(i, 0x0900)) << "slave " << i;
+  }
+}
+
 }  // namespace
 }  // namespace ecsim::testing
