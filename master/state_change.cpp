@@ -80,9 +80,14 @@ bool StateChangeTask::step(SimTime now) {
       if (batch_.pending()) return true;
       if (!takeReads(now)) return finish();
       batch_.clear();
-      for (const auto& slave : slaves_) {
+      ackSent_.assign(slaves_.size(), false);
+      for (std::size_t i = 0; i < slaves_.size(); ++i) {
+        const auto& slave = slaves_[i];
         std::uint16_t value = static_cast<std::uint16_t>(target_);
-        if (slave.alError() && options_.acknowledgeErrors) value |= kAlErrorFlag;
+        if (slave.alError() && options_.acknowledgeErrors) {
+          value |= kAlErrorFlag;
+          ackSent_[i] = true;
+        }
         batch_.add().fpwr(slave.station, reg::kAlControl, value);
       }
       batch_.queueAll(transport_);
@@ -113,7 +118,13 @@ bool StateChangeTask::step(SimTime now) {
       bool pending = false;
       for (std::size_t position : reading_) {
         SlaveInfo& slave = slaves_[position];
-        if (slave.alError() && slave.state() == target_ && slave.alStatusCode == 0) {
+        // The echo of our own request: target state with the error flag, code 0, or exactly
+        // the value we wrote with the acknowledge bit (a device-emulation ESC copies AL control
+        // and never writes the code register, which keeps whatever it held).
+        const bool echo = slave.alError() && slave.state() == target_ &&
+                          (slave.alStatusCode == 0 ||
+                           (position < ackSent_.size() && ackSent_[position]));
+        if (echo) {
           // Device emulation (ESC datasheet section II 0x0120): the ESC copies AL control into
           // AL status as written, so an acknowledge bit sent with the request comes back as
           // the error flag (a real EL1004: soem-sdinfo-ek1100-el1004.pcapng frames 289/293).

@@ -78,6 +78,7 @@ class StateChangeTask final : public Task {
   std::vector<std::size_t> reading_;  // positions of the slaves in batch_, in order
   DatagramBatch batch_;
   DatagramBatch acks_;
+  std::vector<bool> ackSent_;  // per slave: the last request carried the acknowledge bit
   std::vector<StateRefusal> refusals_;
 };
 

@@ -30,6 +30,11 @@ constexpr SimTime saturatingAdd(SimTime a, SimTime b) {
   if (__builtin_add_overflow(a, b, &sum)) return b > 0 ? kSimTimeMax : kSimTimeMin;
   return sum;
 }
+constexpr SimTime saturatingSub(SimTime a, SimTime b) {
+  SimTime difference = 0;
+  if (__builtin_sub_overflow(a, b, &difference)) return b < 0 ? kSimTimeMax : kSimTimeMin;
+  return difference;
+}
 constexpr SimTime saturatingMul(SimTime a, SimTime b) {
   SimTime product = 0;
   if (__builtin_mul_overflow(a, b, &product)) {

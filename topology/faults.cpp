@@ -507,12 +507,15 @@ Result<std::string> FaultInjector::apply(const FaultAction& a, SimTime now) {
     if (channels == 0) return a.error(slave.name() + " has no scriptable inputs");
     ECSIM_ASSIGN_OR_RETURN(auto ch, a.number("channel", 1, channels));
     const auto channel = static_cast<unsigned>(ch);
+    // The script's time starts now: a square wave set at cycle 0 is high for its first half
+    // period however long the bring-up before cycle 0 took.
+    const auto script = signal->startingAt(now);
     if (di != nullptr) {
-      di->setScript(channel, *signal);
+      di->setScript(channel, script);
     } else if (ai != nullptr) {
-      ai->setScript(channel, *signal);
+      ai->setScript(channel, script);
     } else {
-      enc->setScript(channel, *signal);  // shaft position in turns
+      enc->setScript(channel, script);  // shaft position in turns
     }
     return fmt::format("{} input {} = {}", slave.name(), channel, text);
   }

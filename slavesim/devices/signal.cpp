@@ -139,7 +139,7 @@ double Signal::tableValue(double t) const {
 }
 
 double Signal::value(SimTime t) const {
-  const double s = seconds(t);
+  const double s = seconds(saturatingSub(t, origin_));
   switch (kind_) {
     case Kind::kConstant:
       return a_;

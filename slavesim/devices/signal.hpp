@@ -52,8 +52,15 @@ class Signal {
                                 bool step = false);
 
   Kind kind() const { return kind_; }
-  // The value at simulation time t.
+  // The value at simulation time t. Time counts from the signal's origin: the simulation's
+  // start for a signal of the topology, the instant a scenario or control command set it.
   double value(SimTime t) const;
+  // This signal with its time counted from `origin`.
+  Signal startingAt(SimTime origin) const {
+    Signal s = *this;
+    s.origin_ = origin;
+    return s;
+  }
   const std::vector<Point>& points() const { return points_; }
 
  private:
@@ -65,6 +72,7 @@ class Signal {
   double c_{0.0};  // square: duty; sine: offset; ramp: min
   double d_{0.0};  // square/sine: phase; ramp: max
   double period_{0.0};
+  SimTime origin_{0};
   bool loop_{false};
   bool step_{false};
   std::vector<Point> points_;

@@ -124,10 +124,11 @@ TEST_F(PdoConfigTest, ZeroAssignmentEntriesAndDummyMappingEntriesAreNotObjects) 
   net_.segment().addSlave(makeCoeSlave("Dyn", 0x53, od));
   bringUp();
   auto data = discover(0);
-  ASSERT_EQ(data.sms.size(), 1u);
+  ASSERT_GE(data.sms.size(), 1u);
+  ASSERT_EQ(data.sms[0].sm, 2u);
   ASSERT_EQ(data.sms[0].pdos.size(), 1u) << "the zero entry is no PDO";
   EXPECT_EQ(data.sms[0].pdos[0].index, 0x1600);
-  EXPECT_EQ(data.outputBits(), 24u) << "the dummy entry pads by 8 bits";
+  EXPECT_EQ(data.sms[0].bitLength(), 24u) << "the dummy entry pads by 8 bits";
   EXPECT_TRUE(isPaddingEntry(data.sms[0].pdos[0].entries[0].index));
   EXPECT_FALSE(isPaddingEntry(data.sms[0].pdos[0].entries[1].index));
 }

@@ -1,5 +1,5 @@
-// Test helpers for the ESC's SyncManager and frame-error behaviour: SM channel bytes as a master
-// writes them, and a frame sent through a Segment with a corruption on one cable.
+// Test helpers for the ESC's frame-error behaviour: a frame sent through a Segment with a
+// corruption on one cable (SM channel bytes: smChannelBytes in test_network.hpp).
 #pragma once
 
 #include <gtest/gtest.h>
@@ -7,17 +7,6 @@
 #include "support/test_network.hpp"
 
 namespace ecsim::testing {
-
-// One SyncManager channel (0x0800 + 8n), enabled: start, length, control byte.
-inline std::vector<std::uint8_t> smChannelBytes(std::uint16_t start, std::uint16_t length,
-                                                std::uint8_t control) {
-  std::vector<std::uint8_t> s(reg::kSmSize, 0);
-  writeLe16(s, reg::sm::kPhysicalStart.address, start);
-  writeLe16(s, reg::sm::kLength.address, length);
-  s[reg::sm::kControl.address] = control;
-  s[reg::sm::kActivate.address] = reg::sm::kActivateEnable;
-  return s;
-}
 
 // Corrupts the first frame that enters slave `victim` at port 0.
 struct CorruptAtEntry : topology::WireFaults {

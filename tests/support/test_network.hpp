@@ -31,14 +31,14 @@ inline std::vector<std::uint8_t> withoutDeviceEmulation(std::vector<std::uint8_t
   return sii;
 }
 
-// The 8 register bytes of one SyncManager channel, enabled.
+// One SyncManager channel (0x0800 + 8n) as a master writes it, enabled: start, length, control.
 inline std::vector<std::uint8_t> smChannelBytes(std::uint16_t start, std::uint16_t length,
                                                 std::uint8_t control) {
-  std::vector<std::uint8_t> s(8, 0);
-  writeLe16(s, 0, start);
-  writeLe16(s, 2, length);
-  s[4] = control;
-  s[6] = 1;
+  std::vector<std::uint8_t> s(reg::kSmSize, 0);
+  writeLe16(s, reg::sm::kPhysicalStart.address, start);
+  writeLe16(s, reg::sm::kLength.address, length);
+  s[reg::sm::kControl.address] = control;
+  s[reg::sm::kActivate.address] = reg::sm::kActivateEnable;
   return s;
 }
 
