@@ -146,8 +146,16 @@ bool Esc::readRam(std::uint16_t address, Bytes out, bool orInto, int smIndex) {
     copyOut(&buffers_[bufBase + st.latest * cfg.length + offset]);
     return true;
   }
-  if (smAccess(s, address, out.size()) == SmAccess::kDenied) return false;
+  const SmAccess access = smAccess(s, address, out.size());
+  if (access == SmAccess::kDenied) return false;
   copyOut(&buffers_[bufBase + st.latest * cfg.length + offset]);
+  if (!invalidFrame_) {
+    // Section II 0x0805: "interrupt write" (a buffer the PDI completed) is cleared by the
+    // master's first byte; reading the end address sets "interrupt read" for the PDI.
+    std::uint8_t& status = memory_[base + reg::sm::kStatus.address];
+    if (address == cfg.start) status &= static_cast<std::uint8_t>(~reg::sm::kStatusInterruptWrite);
+    if (access == SmAccess::kEnd) status |= reg::sm::kStatusInterruptRead;
+  }
   return true;
 }
 
@@ -329,8 +337,12 @@ bool Esc::pdiWriteInputs(unsigned s, ConstBytes data) {
   st.latest = done;
   st.writing = next;
   st.hasLatest = true;
+  // The PDI completed a buffer: "interrupt write" for the master (its SM event, 0x0210), and
+  // its own "interrupt read" is cleared by this write (section II 0x0805).
   std::uint8_t& status = memory_[reg::smChannel(s) + reg::sm::kStatus.address];
-  status = static_cast<std::uint8_t>((status & ~reg::sm::kStatusBufferMask) | (done << 4));
+  status = static_cast<std::uint8_t>(
+      (status & ~(reg::sm::kStatusBufferMask | reg::sm::kStatusInterruptRead)) | (done << 4) |
+      reg::sm::kStatusInterruptWrite);
   return true;
 }
 

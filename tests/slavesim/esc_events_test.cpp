@@ -86,5 +86,24 @@ TEST_F(EcatAlEvents, MailboxSmEventWhileAResponseWaits) {
   EXPECT_EQ(one(seg_, Command::kBrd, phys(0, 0x0000), {0}).irq, 0x0000) << "read: empty";
 }
 
+TEST_F(EcatAlEvents, InputBufferSmEventUntilTheMasterReadsTheNewData) {
+  // SM3, 3-buffer inputs with "interrupt in ECAT event request" (control 0x30); mask bit 4 + 3.
+  // Section II 0x0805: "interrupt write" is set when the writer (here the PDI) completed a
+  // buffer and cleared when the reader's first byte is read; the SM's ECAT event follows it.
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0818), smChannelBytes(0x1180, 4, 0x30));
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0200), le16(0x0080));
+  EXPECT_EQ(one(seg_, Command::kBrd, phys(0, 0x0000), {0}).irq, 0x0000) << "nothing written";
+  const std::vector<std::uint8_t> inputs{1, 2, 3, 4};
+  ASSERT_TRUE(seg_.slave(0).esc().pdiWriteInputs(3, inputs));
+  EXPECT_EQ(one(seg_, Command::kBrd, phys(0, 0x0000), {0}).irq, 0x0080) << "new inputs";
+  EXPECT_EQ(one(seg_, Command::kFprd, phys(0x1001, 0x1180), std::vector<std::uint8_t>(4, 0)).data,
+            inputs);
+  EXPECT_EQ(one(seg_, Command::kBrd, phys(0, 0x0000), {0}).irq, 0x0000) << "read by the master";
+  EXPECT_NE(seg_.slave(0).esc().reg8(reg::smChannel(3) + reg::sm::kStatus.address) &
+                reg::sm::kStatusInterruptRead,
+            0)
+      << "buffer completely read: the PDI's interrupt";
+}
+
 }  // namespace
 }  // namespace ecsim::testing
