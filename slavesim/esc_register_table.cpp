@@ -174,7 +174,7 @@ const RegisterBytes& escRegisterBytes() {
         const std::uint32_t a = r.address + i;
         b.ecatWriteMask[a] = r.ecatWriteMask;
         b.pdiWriteMask[a] = r.pdiWriteMask;
-        b.reset[a] = i < 8 ? static_cast<std::uint8_t>(r.reset >> (8 * i)) : 0;
+        b.reset[a] = static_cast<std::uint8_t>(i < 8 ? r.reset >> (8 * i) : 0);
         b.rule[a] = r.rule;
         b.write[a] = r.write;
         b.read[a] = r.read;
