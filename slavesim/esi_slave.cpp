@@ -57,7 +57,12 @@ Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiDevice& device, std::st
   coe::OdBuildOptions odOptions;
   odOptions.vendorId = options.vendorId;
   odOptions.serial = options.serial;
-  auto od = std::make_shared<coe::ObjectDictionary>(coe::buildObjectDictionary(device, odOptions));
+  coe::OdBuildReport report;
+  auto od = std::make_shared<coe::ObjectDictionary>(
+      coe::buildObjectDictionary(device, odOptions, &report));
+  if (options.warnings != nullptr) {
+    for (auto& note : report.notes) options.warnings->push_back(std::move(note));
+  }
   // 0x1018 says what the SII says (they differ when a vendor image carries another identity).
   coe::addIdentityObject(*od, {sii.identity.vendorId, sii.identity.productCode,
                                sii.identity.revision, sii.identity.serial});
@@ -69,6 +74,14 @@ Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiDevice& device, std::st
   }
   pd->setVirtualSyncManagers(virtualSms);
   pd->updateProfile(profile);
+  if (!pd->bindStatus().ok() && options.warnings != nullptr) {
+    // A real device with this description would refuse PREOP->SAFEOP with 0x001D/0x001E until
+    // a master assigns PDOs it can bind; say so now rather than only in the AL status code.
+    options.warnings->push_back("the default PDO configuration cannot be bound (" +
+                                pd->bindStatus().error().context +
+                                "): PREOP->SAFEOP is refused until a master assigns PDOs that "
+                                "can be");
+  }
   profile.sync.initialMode = profile.sync.mode;
   profile.sync.dcSupported = !device.dcOpModes.empty();
   if (options.deviceModels) {

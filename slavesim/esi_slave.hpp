@@ -20,6 +20,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "config/esi.hpp"
 #include "protocol/result.hpp"
@@ -47,6 +48,10 @@ struct EsiSlaveOptions {
   // Parameters of the device model (devices/device_params.hpp). A drive's emergencies go to
   // the slave's CoE server unless models.emergencies is set.
   devices::DeviceModelOptions models;
+  // Where the build says what it could not take as written (dictionary notes of
+  // coe::buildObjectDictionary, a default PDO configuration that cannot be bound); nullptr: not
+  // reported.
+  std::vector<std::string>* warnings{nullptr};
 };
 
 // ET1100 by default. A LAN9252-class ESC (4 SMs, 3 FMMUs, 2 ports, 4 KB process RAM) when

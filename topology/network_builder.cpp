@@ -94,8 +94,11 @@ Result<std::unique_ptr<slavesim::Slave>> SlaveFactory::make(const TopologySlave&
     }
   }
   ECSIM_ASSIGN_OR_RETURN(const EsiDevice configured, withModules(entry, file, *device));
+  std::vector<std::string> notes;
+  options.warnings = &notes;
   auto slave = slavesim::makeSlaveFromEsi(file, configured, entry.name, options);
   if (!slave.ok()) return slave;
+  for (auto& n : notes) warnings_.push_back("slave '" + entry.name + "': " + std::move(n));
   if (auto* od = slavesim::objectDictionaryOf(**slave)) {
     for (const auto& input : entry.inputs) {
       const auto* e = od->findEntry(input.index, input.subIndex);

@@ -305,6 +305,38 @@ void addMappedObjects(ObjectDictionary& od, const EsiPdo& pdo, bool rx,
   }
 }
 
+// The first of a PDO's entries that an object of the dictionary cannot take (the object
+// exists, was not made up here, and holds fewer or more bits than the entry maps), as text.
+std::optional<std::string> conflictingEntry(const ObjectDictionary& od, const EsiPdo& pdo,
+                                            const std::set<std::uint32_t>& created) {
+  for (const auto& pe : pdo.entries) {
+    if (pe.index == 0 || created.count(key(pe)) != 0) continue;
+    const Entry* e = od.findEntry(pe.index, pe.subIndex);
+    if (e != nullptr && e->bitLength != pe.bitLength) {
+      return hex4(pe.index) + ":" + std::to_string(pe.subIndex) + " (" +
+             std::to_string(pe.bitLength) + " bits mapped, the object has " +
+             std::to_string(e->bitLength) + ")";
+    }
+  }
+  return std::nullopt;
+}
+
+// A mapping object's entries as an ESI PDO (no names or types: those come from the bits), so
+// that addMappedObjects makes up what the dictionary lacks for it.
+EsiPdo pdoOfMapping(const ObjectDictionary& od, const Object& mapping) {
+  EsiPdo pdo;
+  pdo.index = mapping.index;
+  for (const MappedObject& m : mappedObjects(od, mapping.index)) {
+    EsiPdoEntry e;
+    e.index = m.index;
+    e.subIndex = m.subindex;
+    e.bitLength = m.bitLength;
+    e.name = mapping.name;
+    pdo.entries.push_back(std::move(e));
+  }
+  return pdo;
+}
+
 std::string hexList(const std::vector<std::uint16_t>& values) {
   std::string out;
   for (auto v : values) out += (out.empty() ? "" : ", ") + hex4(v);
@@ -422,11 +454,20 @@ ObjectDictionary buildObjectDictionary(const EsiDevice& device, const OdBuildOpt
       rules.mandatory = pdo.mandatory;
       rules.defaultSm = pdo.sm;
       rules.excludes = pdo.excludes;
-      addMappedObjects(od, pdo, rx, created);
       std::vector<MappedObject> entries = mappingOf(pdo);
       if (Object* existing = od.find(pdo.index); existing != nullptr) {
         limitWritesToPreOp(*existing, pdo.fixed);
         const std::vector<MappedObject> esiMapping = mappedObjects(od, pdo.index);
+        if (auto conflict = conflictingEntry(od, pdo, created);
+            conflict && !esiMapping.empty()) {
+          // Beckhoff_EL3xxx.xml, EL3632: TxPdo 0x1A41 "Ch2 Sample" names 16 bits of 0x6000:02
+          // (Ch1's 1-bit status), the dictionary's 0x1A41 maps 0x6012:01. A PDO that cannot
+          // be bound is no description of the device: the dictionary's mapping stays.
+          note(hex4(pdo.index) + ": the PDO's entries (line " + std::to_string(pdo.line) +
+               ") cannot be mapped: " + *conflict + "; the dictionary's default mapping is kept");
+          continue;
+        }
+        addMappedObjects(od, pdo, rx, created);
         const bool same = std::equal(esiMapping.begin(), esiMapping.end(), entries.begin(),
                                      entries.end(), [](const auto& a, const auto& b) {
                                        return a.raw() == b.raw();
@@ -443,6 +484,7 @@ ObjectDictionary buildObjectDictionary(const EsiDevice& device, const OdBuildOpt
         }
         continue;
       }
+      addMappedObjects(od, pdo, rx, created);
       PdoMappingSpec spec;
       spec.index = pdo.index;
       spec.name = pdo.name();
@@ -452,6 +494,23 @@ ObjectDictionary buildObjectDictionary(const EsiDevice& device, const OdBuildOpt
       spec.capacity = pdoConfig && !pdo.fixed ? options.configurableMappingCapacity : 0;
       addPdoMapping(od, spec);
     }
+  }
+
+  // Mapping objects of the dictionary that no PDO of the device describes (the oversampling
+  // PDOs 0x1A02..0x1A32 of an EL3632 with OSFac up to 50) may map objects the dictionary lacks:
+  // made up from the mapping, so that a master that assigns them gets what it mapped.
+  std::size_t madeUp = created.size();
+  std::vector<const Object*> mappings;
+  for (const auto& [index, object] : od.objects()) {
+    if (isPdoMappingIndex(index)) mappings.push_back(&object);
+  }
+  for (const Object* mapping : mappings) {
+    addMappedObjects(od, pdoOfMapping(od, *mapping), isRxPdoMappingIndex(mapping->index), created);
+  }
+  if (created.size() > madeUp) {
+    note(std::to_string(created.size() - madeUp) +
+         " entries mapped by the dictionary's PDO mapping objects are not in the dictionary: "
+         "made up from the mappings");
   }
 
   // PDO assignment per process-data SM.

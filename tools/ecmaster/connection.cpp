@@ -29,6 +29,7 @@ Result<std::unique_ptr<Connection>> Connection::open(const ConnectOptions& optio
   if (!options.simTopology.empty()) {
     ECSIM_ASSIGN_OR_RETURN(TopologyConfig config, loadTopologyFile(options.simTopology));
     ECSIM_ASSIGN_OR_RETURN(c->network_, topology::buildNetwork(config));
+    for (const auto& w : c->network_.warnings) fmt::print(stderr, "ecmaster: warning: {}\n", w);
     c->description_ = "simulated network " + options.simTopology;
   } else {
     c->network_.segment = std::make_unique<topology::Segment>();
