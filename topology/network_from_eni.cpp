@@ -5,6 +5,7 @@
 #include <map>
 
 #include "config/esi.hpp"
+#include "protocol/bytes.hpp"
 
 namespace ecsim::topology {
 namespace {
@@ -46,6 +47,66 @@ std::vector<Candidate> catalogue(const std::vector<std::filesystem::path>& dirs)
   return out;
 }
 
+// ETG.5001 0xF030 Configured Module List: what a configuration tool downloads to a modular
+// device (TwinCAT as a CoE init command, complete access from sub 0 or one subindex at a time).
+constexpr std::uint16_t kConfiguredModuleListIndex = 0xF030;
+constexpr std::size_t kModuleIdentBytes = 4;
+
+// The module idents a slave's CoE init commands download to 0xF030, in slot order; empty when
+// there are none. A complete access stream holds sub 0 (the count) in one byte, padded to two
+// when the entries start at bit 16 as in the vendors' dictionaries; both are taken.
+Result<std::vector<TopologyModule>> modulesOf(const EniSlave& s, const std::filesystem::path& file) {
+  std::vector<TopologyModule> out;
+  if (!s.mailbox) return out;
+  std::map<unsigned, TopologyModule> bySub;
+  std::optional<unsigned> count;
+  for (const EniCoeCmd& c : s.mailbox->coeInitCmds) {
+    if (c.ccs != 1 || c.index != kConfiguredModuleListIndex) continue;
+    auto bad = [&](const std::string& what) {
+      return makeError(ErrorCode::kInvalidArgument,
+                       file.string() + ", line " + std::to_string(c.line) + ": slave '" + s.name +
+                           "': 0xF030 init command: " + what);
+    };
+    if (c.completeAccess) {
+      if (c.data.empty()) return bad("no data");
+      const std::size_t n = c.data[0];
+      std::size_t offset = 1;
+      if (c.data.size() == 2 + n * kModuleIdentBytes) {
+        offset = 2;
+      } else if (c.data.size() != 1 + n * kModuleIdentBytes) {
+        return bad(std::to_string(c.data.size()) + " bytes of data for " + std::to_string(n) +
+                   " modules");
+      }
+      for (std::size_t i = 0; i < n; ++i) {
+        bySub[static_cast<unsigned>(i + 1)] = {
+            "", readLe32(c.data, offset + i * kModuleIdentBytes), c.line};
+      }
+      count = static_cast<unsigned>(n);
+    } else if (c.subIndex == 0) {
+      if (c.data.empty()) return bad("no data for sub 0");
+      count = c.data[0];
+    } else {
+      if (c.data.size() != kModuleIdentBytes) {
+        return bad("sub " + std::to_string(c.subIndex) + " has " + std::to_string(c.data.size()) +
+                   " bytes, a module ident has 4");
+      }
+      bySub[c.subIndex] = {"", readLe32(c.data, 0), c.line};
+    }
+  }
+  const unsigned n = count.value_or(static_cast<unsigned>(bySub.size()));
+  for (unsigned sub = 1; sub <= n; ++sub) {
+    auto found = bySub.find(sub);
+    if (found == bySub.end()) {
+      return makeError(ErrorCode::kInvalidArgument,
+                       file.string() + ", line " + std::to_string(s.line) + ": slave '" + s.name +
+                           "': 0xF030 lists " + std::to_string(n) + " modules but sets no sub " +
+                           std::to_string(sub));
+    }
+    out.push_back(found->second);
+  }
+  return out;
+}
+
 }  // namespace
 
 Result<TopologyConfig> topologyFromEni(const EniConfig& eni,
@@ -81,6 +142,7 @@ Result<TopologyConfig> topologyFromEni(const EniConfig& eni,
     slave.productCode = best->product;
     slave.revision = best->revision;
     slave.line = s.line;
+    ECSIM_ASSIGN_OR_RETURN(slave.modules, modulesOf(s, eni.file));
     config.slaves.push_back(std::move(slave));
     byAddress[s.physAddr] = i;
   }
@@ -119,6 +181,8 @@ Result<Network> buildNetworkFromEni(const std::filesystem::path& eniFile,
   ECSIM_ASSIGN_OR_RETURN(EniConfig eni, loadEniFile(eniFile));
   ECSIM_ASSIGN_OR_RETURN(TopologyConfig config, topologyFromEni(eni, esiDirs));
   ECSIM_ASSIGN_OR_RETURN(Network network, buildNetwork(config));
+  // The ENI's own warnings first, then what building the devices reported.
+  eni.warnings.insert(eni.warnings.end(), network.warnings.begin(), network.warnings.end());
   network.warnings = std::move(eni.warnings);
   return network;
 }

@@ -17,6 +17,7 @@
 #include "slavesim/esi_slave.hpp"
 #include "support/test_network.hpp"
 #include "topology/network_builder.hpp"
+#include "topology/network_from_eni.hpp"
 
 namespace ecsim::testing {
 namespace {
@@ -117,6 +118,64 @@ TEST(ModularDevice, UnknownModuleTypeNamesTheClosest) {
                                        "'UR20-4DI-P'?"),
             std::string::npos)
       << slave.error().context;
+}
+
+// The same station from an ENI: TwinCAT configures a modular device by downloading its module
+// idents to 0xF030 (ETG.5001 Configured Module List) as a CoE init command; the simulated
+// device gets those modules, by complete access (sub 0 padded to 16 bits, as the entries of
+// 0xF030 start at bit 16 in the vendor's dictionary) or one subindex at a time.
+std::string ur20Eni(const std::string& initCmds) {
+  return "<?xml version=\"1.0\"?>\n<EtherCATConfig><Config>\n<Slave>\n"
+         "<Info><Name>Station</Name><PhysAddr>1001</PhysAddr><VendorId>#x00000230</VendorId>"
+         "<ProductCode>#x4F911C30</ProductCode><RevisionNo>#x00000001</RevisionNo></Info>\n"
+         "<Mailbox><Send><Start>#x1000</Start><Length>128</Length></Send>"
+         "<Recv><Start>#x1080</Start><Length>128</Length></Recv>\n<CoE><InitCmds>\n" +
+         initCmds + "</InitCmds></CoE></Mailbox>\n</Slave>\n</Config></EtherCATConfig>\n";
+}
+
+std::string downloadCmd(int sub, const char* data, bool completeAccess) {
+  return std::string("<InitCmd") + (completeAccess ? " CompleteAccess=\"1\"" : "") +
+         "><Transition>PS</Transition><Comment>download slot cfg</Comment><Ccs>1</Ccs>"
+         "<Index>#xF030</Index><SubIndex>" + std::to_string(sub) + "</SubIndex><Data>" + data +
+         "</Data></InitCmd>\n";
+}
+
+Result<topology::Network> networkFromEniText(const std::string& text) {
+  const fs::path file =
+      fs::temp_directory_path() / ("ecsim-modular-eni-" + std::to_string(::getpid()) + ".xml");
+  std::ofstream(file) << text;
+  auto network = topology::buildNetworkFromEni(file, {sharedEsi()});
+  fs::remove(file);
+  return network;
+}
+
+TEST(ModularDevice, EniModuleListDownloadChoosesTheModules) {
+  ECSIM_REQUIRE_UR20();
+  const std::string completeAccess = downloadCmd(0, "0200841F0900A02F0101", true);
+  const std::string oneByOne = downloadCmd(0, "00", false) +
+                               downloadCmd(1, "841F0900", false) +
+                               downloadCmd(2, "A02F0101", false) + downloadCmd(0, "02", false);
+  for (const std::string& cmds : {completeAccess, oneByOne}) {
+    auto network = networkFromEniText(ur20Eni(cmds));
+    ASSERT_TRUE(network.ok()) << network.error().message();
+    auto* od = slavesim::objectDictionaryOf(network->segment->slave(0));
+    ASSERT_NE(od, nullptr);
+    EXPECT_EQ(od->get<std::uint8_t>(0xF050, 0).value(), 2);
+    EXPECT_EQ(od->get<std::uint32_t>(0xF050, 1).value(), 0x00091F84u) << "UR20-4DI-P";
+    EXPECT_EQ(od->get<std::uint32_t>(0xF050, 2).value(), 0x01012FA0u) << "UR20-4DO-P";
+    // The UR20-4DO-P in slot 1 brings its RxPDO 0x1601 into the assignment.
+    EXPECT_EQ(od->get<std::uint16_t>(0x1C12, 2).value(), 0x1601);
+  }
+}
+
+TEST(ModularDevice, EniModuleListWithAMissingSubindexIsAnError) {
+  ECSIM_REQUIRE_UR20();
+  auto network = networkFromEniText(
+      ur20Eni(downloadCmd(1, "841F0900", false) + downloadCmd(0, "02", false)));
+  ASSERT_FALSE(network.ok());
+  EXPECT_NE(network.error().context.find("0xF030 lists 2 modules but sets no sub 2"),
+            std::string::npos)
+      << network.error().context;
 }
 
 }  // namespace
