@@ -98,7 +98,10 @@ Result<std::unique_ptr<slavesim::Slave>> SlaveFactory::make(const TopologySlave&
   options.warnings = &notes;
   auto slave = slavesim::makeSlaveFromEsi(file, configured, entry.name, options);
   if (!slave.ok()) return slave;
-  for (auto& n : notes) warnings_.push_back("slave '" + entry.name + "': " + std::move(n));
+  for (auto& n : notes) {
+    warnings_.push_back("slave '" + entry.name + "' (" + entry.esiFile.string() + "): " +
+                        std::move(n));
+  }
   if (auto* od = slavesim::objectDictionaryOf(**slave)) {
     for (const auto& input : entry.inputs) {
       const auto* e = od->findEntry(input.index, input.subIndex);

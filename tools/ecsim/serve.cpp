@@ -116,7 +116,6 @@ int runServe(ServeOptions o) {
       return 1;
     }
     network = std::move(built).value();
-    for (const auto& w : network.warnings) fmt::print(stderr, "ecsim serve: warning: {}\n", w);
   } else if (!o.topology.empty()) {
     auto config = loadTopologyFile(o.topology);
     if (!config.ok()) {
@@ -137,6 +136,8 @@ int runServe(ServeOptions o) {
     network.segment->wireLine();
     network.cables.push_back({"master", 0, 0});
   }
+  // What the ENI reader ignored and what building the devices could not take as written.
+  for (const auto& w : network.warnings) fmt::print(stderr, "ecsim serve: warning: {}\n", w);
   topology::Segment& segment = *network.segment;
 
   RealClock clock;
