@@ -2,6 +2,8 @@
 // the same bytes.
 #include <fmt/core.h>
 
+#include <map>
+
 #include "config/xml_util.hpp"
 #include "scenario/runner.hpp"
 
@@ -97,40 +99,84 @@ std::string formatReport(const ScenarioResult& r) {
   return out;
 }
 
-std::string formatJunit(const std::vector<ScenarioResult>& results) {
+namespace {
+
+std::string seconds(double s) {
+  return fmt::format("{:.3f}", s);
+}
+
+// Testcase names of one suite: what each expectation expects, made unique in file order.
+std::vector<std::string> testcaseNames(const ScenarioResult& r) {
+  std::vector<std::string> names;
+  std::map<std::string, int> seen;
+  for (const auto& x : r.results) {
+    const int n = ++seen[x.what];
+    names.push_back(n == 1 ? x.what : fmt::format("{} #{}", x.what, n));
+  }
+  return names;
+}
+
+}  // namespace
+
+std::string formatJunit(const std::vector<ScenarioResult>& results, const JunitContext& context) {
   std::size_t tests = 0, failures = 0, errors = 0;
+  double total = 0.0;
   for (const auto& r : results) {
     tests += r.error.empty() ? r.results.size() : 1;
     failures += r.failures();
     errors += r.error.empty() ? 0 : 1;
+    total += r.wallSeconds;
   }
   std::string out = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
   out += fmt::format(
-      "<testsuites name=\"ecsim scenarios\" tests=\"{}\" failures=\"{}\" "
-      "errors=\"{}\">\n",
-      tests, failures, errors);
+      "<testsuites name=\"ecsim scenarios\" tests=\"{}\" failures=\"{}\" errors=\"{}\" "
+      "time=\"{}\">\n",
+      tests, failures, errors, seconds(total));
   for (const auto& r : results) {
+    const std::size_t cases = r.error.empty() ? r.results.size() : 1;
     out += fmt::format(
-        "  <testsuite name=\"{}\" file=\"{}\" tests=\"{}\" failures=\"{}\" "
-        "errors=\"{}\">\n",
-        xmlEscape(r.name), xmlEscape(r.file), r.error.empty() ? r.results.size() : 1, r.failures(),
-        r.error.empty() ? 0 : 1);
+        "  <testsuite name=\"{}\" tests=\"{}\" failures=\"{}\" errors=\"{}\" skipped=\"0\" "
+        "time=\"{}\"",
+        xmlEscape(r.name), cases, r.failures(), r.error.empty() ? 0 : 1, seconds(r.wallSeconds));
+    if (!context.timestamp.empty()) {
+      out += fmt::format(" timestamp=\"{}\"", xmlEscape(context.timestamp));
+    }
+    if (!context.hostname.empty()) out += fmt::format(" hostname=\"{}\"", xmlEscape(context.hostname));
+    out += fmt::format(" file=\"{}\">\n", xmlEscape(r.file));
+    out += fmt::format(
+        "    <properties>\n      <property name=\"seed\" value=\"{}\"/>\n"
+        "      <property name=\"cycleTimeUs\" value=\"{}\"/>\n"
+        "      <property name=\"cycles\" value=\"{}\"/>\n    </properties>\n",
+        r.seed, r.cycleTime / kNsPerUs, r.cycles);
+    const std::string caseTime = seconds(cases == 0 ? 0.0 : r.wallSeconds / static_cast<double>(cases));
+    const std::string classname = "scenario." + xmlEscape(r.name);
     if (!r.error.empty()) {
       out += fmt::format(
-          "    <testcase name=\"run\" classname=\"scenario.{}\">\n"
-          "      <error message=\"{}\"/>\n    </testcase>\n",
-          xmlEscape(r.name), xmlEscape(r.error));
+          "    <testcase name=\"run\" classname=\"{}\" time=\"{}\">\n"
+          "      <error message=\"{}\" type=\"ScenarioError\">{}</error>\n    </testcase>\n",
+          classname, caseTime, xmlEscape(r.error), xmlEscape(r.error));
     }
-    for (const auto& x : r.results) {
-      out += fmt::format("    <testcase name=\"line {}: {}\" classname=\"scenario.{}\"", x.line,
-                         xmlEscape(x.what), xmlEscape(r.name));
+    const std::vector<std::string> names = testcaseNames(r);
+    for (std::size_t i = 0; i < r.results.size(); ++i) {
+      const auto& x = r.results[i];
+      out += fmt::format(
+          "    <testcase name=\"{}\" classname=\"{}\" time=\"{}\" file=\"{}\" line=\"{}\"",
+          xmlEscape(names[i]), classname, caseTime, xmlEscape(r.file), x.line);
       if (x.passed) {
         out += "/>\n";
-      } else {
-        out += fmt::format(">\n      <failure message=\"at {:.3f} ms: {}\"/>\n    </testcase>\n",
-                           static_cast<double>(x.at) / kNsPerMs, xmlEscape(x.observed));
+        continue;
       }
+      const std::string message =
+          fmt::format("at {:.3f} ms: {}", static_cast<double>(x.at) / kNsPerMs, x.observed);
+      out += fmt::format(
+          ">\n      <failure message=\"{}\" type=\"ExpectationFailed\">{}, line {}: {}\n"
+          "expected: {}\nobserved {}{}</failure>\n    </testcase>\n",
+          xmlEscape(message), xmlEscape(r.file), x.line, xmlEscape(x.what), xmlEscape(x.what),
+          xmlEscape(message), x.needsRecovery ? " [needs recovery]" : "");
     }
+    std::string log;
+    for (const auto& line : r.log) log += line + "\n";
+    out += fmt::format("    <system-out>{}</system-out>\n", xmlEscape(log));
     out += "  </testsuite>\n";
   }
   return out + "</testsuites>\n";

@@ -46,6 +46,9 @@ struct ScenarioResult {
   std::vector<std::string> log;  // "  12.000 ms  cycle 12  link-down cable=drives: ..."
   std::vector<ExpectationResult> results;
   std::string error;  // the run could not be carried out (setup, master start)
+  // Wall-clock seconds the run took, filled in by whoever timed it (the core reads no clock);
+  // the JUnit report's `time`.
+  double wallSeconds{0.0};
   bool passed() const;
   std::size_t failures() const;
 };
@@ -59,7 +62,18 @@ Result<topology::Network> buildScenarioNetwork(const Scenario& scenario);
 
 // Human-readable report of one run (no wall-clock content: deterministic).
 std::string formatReport(const ScenarioResult& result);
-// JUnit XML: one testsuite per scenario, one testcase per expectation.
-std::string formatJunit(const std::vector<ScenarioResult>& results);
+// What a JUnit report says of where and when it ran (the caller reads clock and host name).
+struct JunitContext {
+  std::string timestamp;  // start of the runs, ISO 8601 without zone ("2026-11-28T18:30:00")
+  std::string hostname;
+};
+// JUnit XML: one testsuite per scenario, one testcase per expectation, named by what it
+// expects (stable when lines move; a repeated name gets " #2", " #3"); a failure's text in
+// the element's body with type "ExpectationFailed", a run that could not be carried out as an
+// error of type "ScenarioError"; the scenario's log in <system-out>. Every suite and testcase
+// has `time`: the run's wall time, shared evenly by its testcases (one run decides them all).
+// Structure: tests/scenario/junit.xsd.
+std::string formatJunit(const std::vector<ScenarioResult>& results,
+                        const JunitContext& context = {});
 
 }  // namespace ecsim::scenario
