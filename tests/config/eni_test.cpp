@@ -194,6 +194,27 @@ TEST(EniTest, MoreSlavesThanTheAddressSpaceAreRefused) {
       << over.error().context;
 }
 
+// Issue #16: what the reader drops and a master would need is a warning with file and line:
+// init commands of a mailbox protocol other than CoE (ETG.2100 Mailbox/SoE|EoE|.../InitCmds).
+// Other children the reader does not take (vendor extensions) give none.
+TEST(EniTest, DroppedInitCommandsOfOtherMailboxProtocolsAreWarnedAbout) {
+  const std::string mailbox =
+      "<Mailbox><Send><Start>4096</Start><Length>128</Length></Send>\n"
+      "<Recv><Start>4224</Start><Length>128</Length></Recv>\n"
+      "<Protocol>SoE</Protocol><VendorExtension/>\n"
+      "<SoE>\n<InitCmds>\n<InitCmd><Transition>PS</Transition></InitCmd>\n"
+      "<InitCmd><Transition>PS</Transition></InitCmd>\n</InitCmds>\n</SoE>\n</Mailbox>\n";
+  auto eni = parseEni(eniWith("<Slave>\n" + kInfo + mailbox + "</Slave>\n"), "soe.xml");
+  ASSERT_TRUE(eni.ok()) << eni.error().message();
+  ASSERT_EQ(eni->warnings.size(), 1u);
+  EXPECT_EQ(eni->warnings[0],
+            "soe.xml, line 10: 2 <SoE> init command(s) ignored: only CoE init commands are sent");
+  auto plain =
+      parseEni(eniWith("<Slave>\n" + kInfo + "<Vendor><X/></Vendor>\n</Slave>\n"), "plain.xml");
+  ASSERT_TRUE(plain.ok()) << plain.error().message();
+  EXPECT_TRUE(plain->warnings.empty());
+}
+
 // Issue #21: cycle times are bounded; vendor files are tolerant, so an absurd one is a warning
 // naming file and line, and the value is ignored.
 TEST(EniTest, AbsurdCycleTimesAreWarnedAboutAndIgnored) {
