@@ -48,24 +48,25 @@ void findUnknownNames(const Context& ctx, const Element* e, const Names& names, 
   const auto known = [](const std::vector<std::string_view>& list, std::string_view name) {
     return std::find(list.begin(), list.end(), name) != list.end();
   };
-  const std::string where = std::string(" on <") + e->Name() + ">";
+  // Built only for a message: a file of 65,535 slaves is checked without them.
+  const auto on = [&] { return std::string(" on <") + e->Name() + ">"; };
+  const auto in = [&] { return std::string(" in <") + e->Name() + ">"; };
   for (const tinyxml2::XMLAttribute* a = e->FirstAttribute(); a != nullptr; a = a->Next()) {
     if (!known(names.attributes, a->Name())) {
-      if (!report(ctx.error(e, unknownNameText("attribute", a->Name(), names.attributes, where))))
+      if (!report(ctx.error(e, unknownNameText("attribute", a->Name(), names.attributes, on()))))
         return;
     }
   }
-  const std::string in = std::string(" in <") + e->Name() + ">";
   std::vector<std::string_view> seen;
   for (const Element* child : Children(e, nullptr)) {
     const std::string_view name = child->Name();
     if (!known(names.children, name)) {
-      if (!report(ctx.error(child, unknownNameText("element", name, names.children, in, "<>"))))
+      if (!report(ctx.error(child, unknownNameText("element", name, names.children, in(), "<>"))))
         return;
     } else if (known(names.once, name)) {
       if (known(seen, name)) {
         if (!report(
-                ctx.error(child, "second <" + std::string(name) + ">" + in + " (it takes one)")))
+                ctx.error(child, "second <" + std::string(name) + ">" + in() + " (it takes one)")))
           return;
       }
       seen.push_back(name);
