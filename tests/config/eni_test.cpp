@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "config/master_config.hpp"
+#include "config/xml_util.hpp"
 
 namespace ecsim {
 namespace {
@@ -192,6 +193,27 @@ TEST(EniTest, MoreSlavesThanTheAddressSpaceAreRefused) {
   EXPECT_NE(over.error().context.find("big.xml, line 65539: more than 65535 slaves"),
             std::string::npos)
       << over.error().context;
+}
+
+// The tolerant variant of the names check (vendor formats): every finding is a warning with file
+// and line, in document order, and nothing stops; the strict one stops at the first as an error.
+TEST(XmlNames, WarningsListEveryFindingTheStrictCheckStopsAtTheFirst) {
+  tinyxml2::XMLDocument doc;
+  const xml::Context parse("v.xml");
+  ASSERT_TRUE(
+      xml::parseDocument("<Device Typ=\"1\">\n<Nmae/>\n<Info/>\n<Info/>\n</Device>\n", parse, doc)
+          .ok());
+  const xml::Names names{{"Type"}, {"Name", "Info"}, {"Info"}};
+  std::vector<std::string> warnings;
+  xml::warnUnknownNames(xml::Context("v.xml", &warnings), doc.RootElement(), names);
+  EXPECT_EQ(warnings,
+            (std::vector<std::string>{
+                "v.xml, line 1: unknown attribute 'Typ' on <Device>; did you mean 'Type'?",
+                "v.xml, line 2: unknown element <Nmae> in <Device>; did you mean <Name>?",
+                "v.xml, line 4: second <Info> in <Device> (it takes one)"}));
+  auto strict = xml::checkNames(parse, doc.RootElement(), names);
+  ASSERT_FALSE(strict.ok());
+  EXPECT_EQ(strict.error().context, warnings[0]);
 }
 
 // Issue #16: what the reader drops and a master would need is a warning with file and line:
