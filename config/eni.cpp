@@ -7,7 +7,6 @@
 
 #include "config/xml_util.hpp"
 #include "protocol/frame.hpp"  // kMaxSlaves
-#include "config/xml_util.hpp"
 #include "protocol/read_file.hpp"
 
 namespace ecsim {
@@ -119,6 +118,19 @@ Result<EniMailbox> mailbox(const Context& ctx, const Element* e) {
     for (const Element* c : Children(coe->FirstChildElement("InitCmds"), "InitCmd")) {
       ECSIM_ASSIGN_OR_RETURN(EniCoeCmd cmd, coeCmd(ctx, c));
       m.coeInitCmds.push_back(std::move(cmd));
+    }
+  }
+  // Init commands of the other mailbox protocols (ETG.2100: SoE, EoE, FoE, AoE, VoE) are
+  // read by nobody: a master configured from this ENI would not send them. A warning, not an
+  // error (vendor format), and only for what is dropped; other extensions stay silent.
+  for (const char* protocol : {"SoE", "EoE", "FoE", "AoE", "VoE"}) {
+    const Element* other = e->FirstChildElement(protocol);
+    const Element* cmds = other == nullptr ? nullptr : other->FirstChildElement("InitCmds");
+    std::size_t n = 0;
+    for ([[maybe_unused]] const Element* c : Children(cmds, "InitCmd")) ++n;
+    if (n > 0) {
+      ctx.warn(cmds, std::to_string(n) + " <" + protocol +
+                         "> init command(s) ignored: only CoE init commands are sent");
     }
   }
   return m;
@@ -305,7 +317,8 @@ const EniSlave* EniConfig::findSlave(std::uint16_t physAddr) const {
 }
 
 Result<EniConfig> parseEni(std::string_view text, const std::filesystem::path& file) {
-  const Context ctx(file.string());
+  EniConfig eni;
+  const Context ctx(file.string(), &eni.warnings);
   tinyxml2::XMLDocument doc;
   ECSIM_TRY(xml::parseDocument(text, ctx, doc));
   const Element* root = doc.RootElement();
@@ -314,7 +327,6 @@ Result<EniConfig> parseEni(std::string_view text, const std::filesystem::path& f
   }
   const Element* config = root->FirstChildElement("Config");
   if (config == nullptr) return ctx.error(root, "<EtherCATConfig> needs <Config>");
-  EniConfig eni;
   eni.file = file;
   if (const Element* m = config->FirstChildElement("Master")) {
     eni.master.name = std::string(xml::childText(m->FirstChildElement("Info"), "Name"));

@@ -1,4 +1,7 @@
-// Reads the master configuration with tinyxml2; ENI files through config/eni.hpp.
+// Reads the master configuration with tinyxml2; ENI files through config/eni.hpp. The simple
+// <EcsimMaster> format is ours and read strictly: any element or attribute besides those in
+// master_config.hpp is an error with the closest valid name (a misspelt `revison` left the
+// revision unchecked).
 #include "config/master_config.hpp"
 
 #include <tinyxml2.h>
@@ -7,6 +10,7 @@
 
 #include "config/eni.hpp"
 #include "config/esi.hpp"
+#include "config/xml_util.hpp"
 #include "protocol/read_file.hpp"
 
 namespace ecsim {
@@ -29,25 +33,26 @@ Result<std::optional<std::uint32_t>> attribute(const tinyxml2::XMLElement* e, co
   return std::optional<std::uint32_t>{static_cast<std::uint32_t>(*value)};
 }
 
+// What each element takes (the file's comment in master_config.hpp); anything else is an error.
+const xml::Names kRootNames{{}, {"Slave"}};
+const xml::Names kSlaveNames{{"name", "vendor", "product", "revision", "serial"}};
+
 }  // namespace
 
 Result<MasterConfig> parseMasterConfig(std::string_view xml, std::string_view fileName) {
+  const xml::Context ctx{std::string(fileName)};
   tinyxml2::XMLDocument doc;
-  if (doc.Parse(xml.data(), xml.size()) != tinyxml2::XML_SUCCESS) {
-    return parseError(fileName, doc.ErrorLineNum(), doc.ErrorStr() ? doc.ErrorStr() : "bad XML");
-  }
+  ECSIM_TRY(xml::parseDocument(xml, ctx, doc));
   const tinyxml2::XMLElement* root = doc.RootElement();
   if (root == nullptr || std::string_view(root->Name()) != "EcsimMaster") {
     return parseError(fileName, root ? root->GetLineNum() : 1,
                       "root element must be <EcsimMaster>");
   }
+  ECSIM_TRY(xml::checkNames(ctx, root, kRootNames));
   MasterConfig config;
   config.file = std::string(fileName);
   for (const auto* e = root->FirstChildElement(); e != nullptr; e = e->NextSiblingElement()) {
-    if (std::string_view(e->Name()) != "Slave") {
-      return parseError(fileName, e->GetLineNum(),
-                        "unknown element <" + std::string(e->Name()) + ">");
-    }
+    ECSIM_TRY(xml::checkNames(ctx, e, kSlaveNames));
     ExpectedSlave slave;
     slave.line = e->GetLineNum();
     if (const char* name = e->Attribute("name")) slave.name = name;

@@ -7,7 +7,6 @@
 #include <sstream>
 
 #include "config/xml_util.hpp"
-#include "protocol/closest_name.hpp"
 #include "protocol/read_file.hpp"
 
 namespace ecsim {
@@ -67,10 +66,25 @@ Result<std::optional<std::int64_t>> attrInteger(const xml::Context& ctx, const E
 
 constexpr std::string_view kCableWhy = " m (the 100BASE-TX segment limit)";
 
+// What each element takes (docs/topology.md); anything else is an error (xml::checkNames).
+const xml::Names kTopologyNames{{"name"}, {"Master", "Slave", "Link"}, {"Master"}};
+const xml::Names kMasterNames{{"cable"}};
+const xml::Names kSlaveNames{{"name", "esi", "product", "revision", "device", "eeprom", "esc",
+                              "dc", "processingDelayNs", "forwardingDelayNs", "stateFile",
+                              "modules"},
+                             {"Clock", "Input", "Param", "Module"},
+                             {"Clock"}};
+const xml::Names kClockNames{{"offsetNs", "driftPpm"}};
+const xml::Names kInputNames{{"entry", "value"}};
+const xml::Names kParamNames{{"name", "value"}};
+const xml::Names kModuleNames{{"type", "ident"}};
+const xml::Names kLinkNames{{"name", "from", "to", "cable"}};
+
 Result<TopologySlave> parseSlave(const xml::Context& ctx, const Element* e,
                                  const std::filesystem::path& folder) {
   TopologySlave s;
   s.line = e->GetLineNum();
+  ECSIM_TRY(xml::checkNames(ctx, e, kSlaveNames));
   const char* name = e->Attribute("name");
   if (name == nullptr || std::string_view(name).empty()) {
     return ctx.error(e, "Slave needs a name attribute");
@@ -103,6 +117,7 @@ Result<TopologySlave> parseSlave(const xml::Context& ctx, const Element* e,
   ECSIM_ASSIGN_OR_RETURN(s.forwardingDelayNs,
                          attrInteger(ctx, e, "forwardingDelayNs", 0, kMaxEscDelayNs));
   if (const Element* clock = e->FirstChildElement("Clock")) {
+    ECSIM_TRY(xml::checkNames(ctx, clock, kClockNames));
     ECSIM_ASSIGN_OR_RETURN(
         auto offset, attrInteger(ctx, clock, "offsetNs", -kMaxClockOffsetNs, kMaxClockOffsetNs));
     s.clockOffsetNs = offset.value_or(0);
@@ -114,6 +129,7 @@ Result<TopologySlave> parseSlave(const xml::Context& ctx, const Element* e,
   for (const Element* in : xml::Children(e, "Input")) {
     TopologyInput input;
     input.line = in->GetLineNum();
+    ECSIM_TRY(xml::checkNames(ctx, in, kInputNames));
     const char* entry = in->Attribute("entry");
     if (entry == nullptr) return ctx.error(in, "Input needs entry=\"INDEX:SUB\"");
     std::string_view text(entry);
@@ -129,6 +145,7 @@ Result<TopologySlave> parseSlave(const xml::Context& ctx, const Element* e,
     s.inputs.push_back(input);
   }
   for (const Element* param : xml::Children(e, "Param")) {
+    ECSIM_TRY(xml::checkNames(ctx, param, kParamNames));
     const char* pname = param->Attribute("name");
     const char* value = param->Attribute("value");
     if (pname == nullptr || value == nullptr) {
@@ -140,16 +157,11 @@ Result<TopologySlave> parseSlave(const xml::Context& ctx, const Element* e,
   for (const Element* m : xml::Children(e, "Module")) {
     TopologyModule module;
     module.line = m->GetLineNum();
+    ECSIM_TRY(xml::checkNames(ctx, m, kModuleNames));
     if (const char* type = m->Attribute("type")) module.type = type;
     ECSIM_ASSIGN_OR_RETURN(module.ident, xml::attrNumber<std::uint32_t>(ctx, m, "ident"));
     if (module.type.empty() == !module.ident.has_value()) {
       return ctx.error(m, "Module needs either type=\"NAME\" or ident=\"#xIDENT\"");
-    }
-    for (const tinyxml2::XMLAttribute* a = m->FirstAttribute(); a != nullptr; a = a->Next()) {
-      const std::string_view attribute = a->Name();
-      if (attribute != "type" && attribute != "ident") {
-        return ctx.error(m, unknownNameText("Module attribute", attribute, {"type", "ident"}));
-      }
     }
     s.modules.push_back(std::move(module));
   }
@@ -157,6 +169,49 @@ Result<TopologySlave> parseSlave(const xml::Context& ctx, const Element* e,
     return ctx.error(e, "Slave '" + s.name + "': modules need a device from an ESI file (esi=)");
   }
   return s;
+}
+
+// Before anything runs: every cable has a name of its own ("master" is the master's), and every
+// slave is reached from the one at the master through the links (a slave no link reaches is
+// not on the wire: a misspelt <Link> took it off without a word).
+Status checkWiring(const xml::Context& ctx, const TopologyConfig& cfg) {
+  std::map<std::string_view, int> names;
+  for (const auto& l : cfg.links) {
+    if (l.name == "master") {
+      return ctx.error(l.line, "cable name 'master' is the master's cable (to the first slave)");
+    }
+    if (auto [it, fresh] = names.emplace(l.name, l.line); !fresh) {
+      return ctx.error(l.line, fmt::format("cable name '{}' given twice (first on line {})",
+                                           l.name, it->second));
+    }
+  }
+  std::vector<std::vector<std::size_t>> neighbours(cfg.slaves.size());
+  for (const auto& l : cfg.links) {
+    neighbours[l.fromSlave].push_back(l.toSlave);
+    neighbours[l.toSlave].push_back(l.fromSlave);
+  }
+  std::vector<bool> reached(cfg.slaves.size(), false);
+  std::vector<std::size_t> todo{0};
+  reached[0] = true;
+  while (!todo.empty()) {
+    const std::size_t s = todo.back();
+    todo.pop_back();
+    for (std::size_t n : neighbours[s]) {
+      if (!reached[n]) {
+        reached[n] = true;
+        todo.push_back(n);
+      }
+    }
+  }
+  for (std::size_t i = 0; i < cfg.slaves.size(); ++i) {
+    if (!reached[i]) {
+      return ctx.error(cfg.slaves[i].line,
+                       fmt::format("slave '{}' is reached by no link from '{}' (the slave at the "
+                                   "master)",
+                                   cfg.slaves[i].name, cfg.slaves[0].name));
+    }
+  }
+  return okStatus();
 }
 
 }  // namespace
@@ -181,11 +236,13 @@ Result<TopologyConfig> parseTopology(std::string_view text, const std::filesyste
   if (root == nullptr || std::string_view(root->Name()) != "Topology") {
     return ctx.error(root, "root element must be <Topology>");
   }
+  ECSIM_TRY(xml::checkNames(ctx, root, kTopologyNames));
   TopologyConfig cfg;
   cfg.file = file;
   if (const char* name = root->Attribute("name")) cfg.name = name;
   const std::filesystem::path folder = file.parent_path();
   if (const Element* master = root->FirstChildElement("Master")) {
+    ECSIM_TRY(xml::checkNames(ctx, master, kMasterNames));
     ECSIM_ASSIGN_OR_RETURN(cfg.masterCableMetres,
                            attrDouble(ctx, master, "cable", 1.0, 0, kMaxCableMetres, kCableWhy));
   }
@@ -204,6 +261,7 @@ Result<TopologyConfig> parseTopology(std::string_view text, const std::filesyste
   for (const Element* e : xml::Children(root, "Link")) {
     TopologyLink link;
     link.line = e->GetLineNum();
+    ECSIM_TRY(xml::checkNames(ctx, e, kLinkNames));
     if (const char* name = e->Attribute("name")) link.name = name;
     ECSIM_ASSIGN_OR_RETURN(auto from, parseEndpoint(ctx, e, "from", cfg));
     ECSIM_ASSIGN_OR_RETURN(auto to, parseEndpoint(ctx, e, "to", cfg));
@@ -226,6 +284,7 @@ Result<TopologyConfig> parseTopology(std::string_view text, const std::filesyste
       l.name = cfg.slaves[l.fromSlave].name + ":" + std::to_string(l.fromPort) + "-" +
                cfg.slaves[l.toSlave].name + ":" + std::to_string(l.toPort);
   }
+  ECSIM_TRY(checkWiring(ctx, cfg));
   return cfg;
 }
 

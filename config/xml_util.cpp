@@ -4,6 +4,8 @@
 #include <array>
 #include <cctype>
 
+#include "protocol/closest_name.hpp"
+
 namespace ecsim::xml {
 namespace {
 
@@ -40,7 +42,55 @@ std::size_t entityReferenceLength(std::string_view s, std::size_t at) {
                                                                                      : 0;
 }
 
+// The findings of checkNames in document order: attributes, then child elements.
+template <typename Report>
+void findUnknownNames(const Context& ctx, const Element* e, const Names& names, Report report) {
+  const auto known = [](const std::vector<std::string_view>& list, std::string_view name) {
+    return std::find(list.begin(), list.end(), name) != list.end();
+  };
+  // Built only for a message: a file of 65,535 slaves is checked without them.
+  const auto on = [&] { return std::string(" on <") + e->Name() + ">"; };
+  const auto in = [&] { return std::string(" in <") + e->Name() + ">"; };
+  for (const tinyxml2::XMLAttribute* a = e->FirstAttribute(); a != nullptr; a = a->Next()) {
+    if (!known(names.attributes, a->Name())) {
+      if (!report(ctx.error(e, unknownNameText("attribute", a->Name(), names.attributes, on()))))
+        return;
+    }
+  }
+  std::vector<std::string_view> seen;
+  for (const Element* child : Children(e, nullptr)) {
+    const std::string_view name = child->Name();
+    if (!known(names.children, name)) {
+      if (!report(ctx.error(child, unknownNameText("element", name, names.children, in(), "<>"))))
+        return;
+    } else if (known(names.once, name)) {
+      if (known(seen, name)) {
+        if (!report(
+                ctx.error(child, "second <" + std::string(name) + ">" + in() + " (it takes one)")))
+          return;
+      }
+      seen.push_back(name);
+    }
+  }
+}
+
 }  // namespace
+
+Status checkNames(const Context& ctx, const Element* e, const Names& names) {
+  Status status = okStatus();
+  findUnknownNames(ctx, e, names, [&](Error error) {
+    status = std::move(error);
+    return false;  // the first is enough
+  });
+  return status;
+}
+
+void warnUnknownNames(const Context& ctx, const Element* e, const Names& names) {
+  findUnknownNames(ctx, e, names, [&](const Error& error) {
+    ctx.warn(error.context);
+    return true;
+  });
+}
 
 std::string escapeText(std::string_view text) {
   std::string out;

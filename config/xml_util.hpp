@@ -1,6 +1,7 @@
-// Small helpers over tinyxml2 shared by the config readers: errors that name file and line,
-// typed text/attribute access in ESI number syntax, and the well-formedness checks tinyxml2
-// leaves out. Internal to config/ (escapeText is also used by the scenario JUnit writer).
+// Small helpers over tinyxml2 shared by the XML readers: errors that name file and line,
+// typed text/attribute access in ESI number syntax, the well-formedness checks tinyxml2 leaves
+// out, and the names table each element of our own formats is checked against (checkNames).
+// Used by config/ and by the scenario reader and JUnit writer.
 #pragma once
 
 #include <tinyxml2.h>
@@ -59,9 +60,7 @@ class Context {
       : file_(std::move(file)), warnings_(warnings) {}
   const std::string& file() const { return file_; }
 
-  void warn(const Element* e, std::string_view message) const {
-    warn(error(e, message).context);
-  }
+  void warn(const Element* e, std::string_view message) const { warn(error(e, message).context); }
   // A message that already names file and line (an Error's context).
   void warn(std::string located) const {
     if (warnings_ != nullptr) warnings_->push_back(std::move(located));
@@ -144,5 +143,23 @@ EsiEncoding declaredEncoding(std::string_view xml);
 
 // Parses `xml` into `doc` with the checks above; errors name file and line.
 Status parseDocument(std::string_view xml, const Context& ctx, tinyxml2::XMLDocument& doc);
+
+// What an element may hold: its attributes, its child elements, and which of those children
+// may appear at most once. The one table per element of a reader.
+struct Names {
+  std::vector<std::string_view> attributes;
+  std::vector<std::string_view> children{};
+  std::vector<std::string_view> once{};
+};
+
+// Our own formats (topology, scenario, master configuration) are strict: the first attribute
+// or child element of `e` that `names` does not list, or a second child listed in `once`, is an
+// error naming the file, the line and the closest valid name ("s.xml, line 1: unknown attribute
+// 'durationMS' on <Scenario>; did you mean 'durationMs'?"; an element: "unknown element <Lnik>
+// in <Topology>; did you mean <Link>?").
+Status checkNames(const Context& ctx, const Element* e, const Names& names);
+// Vendor formats (ESI, ENI) are tolerant: the same findings are warnings (ctx's warning list),
+// every one of them, and reading goes on.
+void warnUnknownNames(const Context& ctx, const Element* e, const Names& names);
 
 }  // namespace ecsim::xml

@@ -11,17 +11,29 @@
 
 namespace ecsim {
 
-// Insertions, deletions and substitutions that turn `a` into `b`.
+// Insertions, deletions, substitutions and swaps of two neighbouring letters that turn `a`
+// into `b` (optimal string alignment distance), ignoring the case of ASCII letters: the slips
+// of a typing hand ("durationMS", "Lnik", "drivse") are all one or no edit away.
 inline std::size_t editDistance(std::string_view a, std::string_view b) {
-  std::vector<std::size_t> row(b.size() + 1);
+  const auto same = [](char x, char y) {
+    const auto lower = [](char c) {
+      return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c;
+    };
+    return lower(x) == lower(y);
+  };
+  // Three rows of the (a.size()+1) x (b.size()+1) table: two back, one back, this one.
+  std::vector<std::size_t> before(b.size() + 1), previous(b.size() + 1), row(b.size() + 1);
   for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
   for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
+    before.swap(previous);
+    previous.swap(row);
     row[0] = i;
     for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t above = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = above;
+      row[j] = std::min(
+          {previous[j] + 1, row[j - 1] + 1, previous[j - 1] + (same(a[i - 1], b[j - 1]) ? 0 : 1)});
+      if (i > 1 && j > 1 && same(a[i - 1], b[j - 2]) && same(a[i - 2], b[j - 1])) {
+        row[j] = std::min(row[j], before[j - 2] + 1);
+      }
     }
   }
   return row[b.size()];
@@ -43,15 +55,27 @@ inline std::optional<std::string_view> closestName(std::string_view name,
   return best;
 }
 
+// "; did you mean 'Drive1'?" when a name in `names` is close to `name`, else "": for messages
+// about names from a long list (slaves, cables) that is not worth listing.
+inline std::string didYouMean(std::string_view name, const std::vector<std::string_view>& names) {
+  if (auto best = closestName(name, names)) return "; did you mean '" + std::string(*best) + "'?";
+  return {};
+}
+
 // "unknown argument 'durationMS'; did you mean 'durationMs'?" when one is close, else
-// "unknown argument 'extra' (valid: cable, port, slave)".
+// "unknown argument 'extra' (valid: cable, port, slave)". `where` follows the name
+// (" on <Scenario>"); `quote` surrounds the names: "'" for values, "<>" for elements.
 inline std::string unknownNameText(std::string_view what, std::string_view name,
-                                   const std::vector<std::string_view>& names) {
-  std::string text = "unknown " + std::string(what) + " '" + std::string(name) + "'";
-  if (auto best = closestName(name, names)) return text + "; did you mean '" + std::string(*best) + "'?";
+                                   const std::vector<std::string_view>& names,
+                                   std::string_view where = {}, std::string_view quote = "''") {
+  const std::string open(quote.substr(0, 1)), close(quote.substr(quote.size() - 1));
+  const auto quoted = [&](std::string_view n) { return open + std::string(n) + close; };
+  std::string text = "unknown " + std::string(what) + " " + quoted(name) + std::string(where);
+  if (auto best = closestName(name, names)) return text + "; did you mean " + quoted(*best) + "?";
+  if (names.empty()) return text + " (it takes none)";
   text += " (valid:";
   for (std::size_t i = 0; i < names.size(); ++i) {
-    text += (i == 0 ? " " : ", ") + std::string(names[i]);
+    text += (i == 0 ? " " : ", ") + (open == "'" ? std::string(names[i]) : quoted(names[i]));
   }
   return text + ")";
 }

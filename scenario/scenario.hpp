@@ -29,6 +29,10 @@
 #include "protocol/time.hpp"
 #include "topology/faults.hpp"
 
+namespace ecsim {
+struct TopologyConfig;
+}
+
 namespace ecsim::scenario {
 
 struct TimedAction {
@@ -87,6 +91,7 @@ struct Expectation {
 
 struct Scenario {
   std::filesystem::path file;
+  int line{0};  // of <Scenario>
   std::string name;
   std::string description;
   std::filesystem::path topology;
@@ -111,8 +116,15 @@ inline constexpr std::string_view kDetectableConditions[] = {
     "slave-state",     "slave-lost",      "slave-returned", "slave-reset",
     "slave-recovered", "recovery-failed", "any-error"};
 
+// Reading is strict (docs/scenarios.md, "Strictness"): an unknown element or attribute, an
+// action or expectation after the end of the run is an error naming the file, the line and the
+// closest valid name. loadScenario also reads the topology and checks the names against it
+// (checkTopologyNames); parseScenario checks the file alone.
 Result<Scenario> loadScenario(const std::filesystem::path& path);
 Result<Scenario> parseScenario(std::string_view xml, const std::filesystem::path& path);
+// Every slave and cable an action or expectation names is in the topology; the error names
+// the scenario's file and line and the closest name the topology has.
+Status checkTopologyNames(const Scenario& scenario, const TopologyConfig& topology);
 // What an external master can be judged on: rejects (naming file and line) the expectations
 // that need the master's internals (Detected, Statistic, Variable, Continuity) and the
 // pause-master action for external masters, and ExitStatus, Output and BackInOp afterMs for the

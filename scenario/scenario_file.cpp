@@ -4,12 +4,17 @@
 #include <fmt/core.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <map>
 #include <sstream>
 
+#include "config/topology_file.hpp"
+#include "config/xml_util.hpp"
+#include "protocol/closest_name.hpp"
 #include "protocol/read_file.hpp"
 #include "scenario/command_output.hpp"
 #include "scenario/scenario.hpp"
@@ -26,15 +31,49 @@ constexpr std::uint64_t kMaxCycles = 2'000'000'000;
 constexpr std::uint64_t kMinCycleUs = 50;
 constexpr std::uint64_t kMaxCycleUs = 1'000'000;
 
+// What each element takes (docs/scenarios.md); anything else is an error (xml::checkNames).
+// Every expectation takes needsRecovery; `when` is cycle/atMs.
+const xml::Names kScenarioNames{{"name", "topology", "cycleUs", "durationMs", "seed"},
+                                {"Description", "Master", "Timeline", "Expect"},
+                                {"Description", "Master", "Timeline", "Expect"}};
+const xml::Names kDescriptionNames{{}};
+const xml::Names kMasterNames{{"kind", "command", "startTimeoutMs", "stopGraceMs", "timeZero"}};
+const xml::Names kTimelineNames{{}, {"Action"}};
+const std::map<std::string_view, xml::Names, std::less<>> kExpectationNames{
+    {"State", {{"slave", "state", "error", "code", "cycle", "atMs", "needsRecovery"}}},
+    {"Detected", {{"condition", "slave", "afterCycle", "withinCycles", "needsRecovery"}}},
+    {"BackInOp", {{"afterCycle", "afterMs", "withinMs", "needsRecovery"}}},
+    {"Register",
+     {{"slave", "address", "width", "mask", "op", "value", "tolerance", "cycle", "atMs",
+       "needsRecovery"}}},
+    {"Statistic",
+     {{"name", "slave", "op", "value", "tolerance", "cycle", "atMs", "needsRecovery"}}},
+    {"Continuity", {{"maxBadCycles", "maxConsecutiveBadCycles", "needsRecovery"}}},
+    {"Variable",
+     {{"slave", "entry", "mask", "signed", "op", "value", "tolerance", "cycle", "atMs",
+       "needsRecovery"}}},
+    // cycle and atMs are refused below with the reason (judged when the command has ended).
+    {"ExitStatus", {{"op", "value", "tolerance", "needsRecovery", "cycle", "atMs"}}},
+    {"Output",
+     {{"contains", "matches", "op", "value", "tolerance", "afterMs", "withinMs", "needsRecovery",
+       "cycle", "atMs"}}},
+};
+const xml::Names kExpectNames = [] {  // the expectations above
+  xml::Names names{{}};
+  for (const auto& [tag, attributes] : kExpectationNames) names.children.push_back(tag);
+  return names;
+}();
+// An <Action>'s own attributes; the others are its verb's arguments.
+constexpr std::array<std::string_view, 3> kActionAttributes{"cycle", "timeMs", "do"};
+// The runner's own verb (scenario/runner.cpp), beside the network's (topology/faults.hpp).
+constexpr std::string_view kPauseMaster = "pause-master";
+
 class Reader {
  public:
-  explicit Reader(std::string file) : file_(std::move(file)) {}
+  explicit Reader(std::string file) : file_(std::move(file)), ctx_(file_) {}
+  const xml::Context& context() const { return ctx_; }
 
-  Error error(const XMLElement* e, const std::string& what) const {
-    return makeError(
-        ErrorCode::kParse,
-        file_ + ", line " + std::to_string(e == nullptr ? 0 : e->GetLineNum()) + ": " + what);
-  }
+  Error error(const XMLElement* e, const std::string& what) const { return ctx_.error(e, what); }
   std::string where(const XMLElement* e) const {
     return file_ + ", line " + std::to_string(e->GetLineNum());
   }
@@ -95,6 +134,7 @@ class Reader {
 
  private:
   std::string file_;
+  xml::Context ctx_;
 };
 
 Result<Compare> parseCompare(const Reader& r, const XMLElement* e) {
@@ -111,25 +151,42 @@ Result<Compare> parseCompare(const Reader& r, const XMLElement* e) {
 Result<TimedAction> readAction(const Reader& r, const XMLElement* e) {
   TimedAction a;
   a.line = e->GetLineNum();
+  a.action.where = r.where(e);
+  auto verb = Reader::attr(e, "do");
+  if (!verb) return r.error(e, "an Action needs do=\"VERB\"");
+  a.action.verb = *verb;
+  std::vector<std::string_view> verbs = topology::faultVerbs();
+  verbs.push_back(kPauseMaster);
+  if (std::find(verbs.begin(), verbs.end(), a.action.verb) == verbs.end()) {
+    return r.error(e, unknownNameText("action", a.action.verb, verbs));
+  }
+  // Its verb's arguments and the Action's own attributes; a misspelt one is an error naming the
+  // closest of them ("delay: unknown argument 'durationMS'; did you mean 'durationMs'?").
+  std::vector<std::string_view> keys = a.action.verb == kPauseMaster
+                                           ? std::vector<std::string_view>{"durationMs"}
+                                           : topology::faultArguments(a.action.verb);
+  keys.insert(keys.end(), kActionAttributes.begin(), kActionAttributes.end());
+  for (const auto* at = e->FirstAttribute(); at != nullptr; at = at->Next()) {
+    if (std::find(keys.begin(), keys.end(), at->Name()) == keys.end()) {
+      return a.action.error(unknownNameText("argument", at->Name(), keys));
+    }
+  }
+  ECSIM_TRY(xml::checkNames(r.context(), e, {keys}));  // and no child elements
   ECSIM_ASSIGN_OR_RETURN(a.cycle, r.number(e, "cycle", 0, kMaxCycles));
   ECSIM_ASSIGN_OR_RETURN(a.time, r.millis(e, "timeMs"));
   if (a.cycle.has_value() == a.time.has_value()) {
     return r.error(e, "an Action needs exactly one of cycle=\"N\" and timeMs=\"T\"");
   }
-  auto verb = Reader::attr(e, "do");
-  if (!verb) return r.error(e, "an Action needs do=\"VERB\"");
-  a.action.verb = *verb;
-  a.action.where = r.where(e);
   for (const auto* at = e->FirstAttribute(); at != nullptr; at = at->Next()) {
     const std::string key = at->Name();
     if (key == "cycle" || key == "timeMs" || key == "do") continue;
     a.action.args[key] = at->Value();
   }
-  const bool runnerVerb = a.action.verb == "pause-master";
-  if (!runnerVerb && !topology::FaultInjector::handles(a.action.verb)) {
-    return r.error(e, "unknown action \"" + a.action.verb + "\"");
+  if (a.action.verb == kPauseMaster) {
+    ECSIM_TRY(a.action.millis("durationMs"));  // required, and in range
+  } else {
+    ECSIM_TRY(topology::checkFaultArguments(a.action));
   }
-  if (!runnerVerb) ECSIM_TRY(topology::checkFaultArguments(a.action));
   return a;
 }
 
@@ -137,6 +194,11 @@ Result<Expectation> readExpectation(const Reader& r, const XMLElement* e) {
   Expectation x;
   x.line = e->GetLineNum();
   const std::string tag = e->Name();
+  const auto table = kExpectationNames.find(tag);
+  if (table == kExpectationNames.end()) {  // kExpectNames lists them all
+    return r.error(e, "unknown expectation <" + tag + ">");
+  }
+  ECSIM_TRY(xml::checkNames(r.context(), e, table->second));
   ECSIM_ASSIGN_OR_RETURN(x.atCycle, r.number(e, "cycle", 0, kMaxCycles));
   ECSIM_ASSIGN_OR_RETURN(x.atTime, r.millis(e, "atMs"));
   ECSIM_ASSIGN_OR_RETURN(auto needs, r.boolean(e, "needsRecovery"));
@@ -222,8 +284,7 @@ Result<Expectation> readExpectation(const Reader& r, const XMLElement* e) {
       }
       if (x.isRegex) {
         if (auto p = OutputPattern::compile(x.text); !p.ok()) {
-          const std::string shown =
-              x.text.size() > 60 ? x.text.substr(0, 60) + "..." : x.text;
+          const std::string shown = x.text.size() > 60 ? x.text.substr(0, 60) + "..." : x.text;
           return r.error(e, "matches=\"" + shown + "\": " + p.error().context);
         }
       }
@@ -279,6 +340,64 @@ Result<Expectation> readExpectation(const Reader& r, const XMLElement* e) {
   return x;
 }
 
+// Before anything runs: no action and no expectation after the end of the run. Ours runs the
+// cycles 0 .. durationMs/cycleUs - 1 and checks at the end what is due then; an external
+// master runs durationMs after time zero and counts its own cycles (frames), which are not
+// known before.
+struct RunEnd {
+  bool external;
+  std::uint64_t cycles;    // ours: the number of cycles
+  SimTime lastCycleStart;  // ours: when the last cycle starts
+  SimTime duration;
+};
+RunEnd runEnd(const Scenario& s) {
+  const auto cycles = static_cast<std::uint64_t>(s.duration / s.cycleTime);
+  return {s.masterKind == "external", cycles, static_cast<SimTime>(cycles - 1) * s.cycleTime,
+          s.duration};
+}
+std::string msText(SimTime t) {
+  return fmt::format("{}", static_cast<double>(t) / static_cast<double>(kNsPerMs));
+}
+Error afterTheEnd(const Reader& r, const XMLElement* e, const char* attribute,
+                  const std::string& end) {
+  return r.error(e, fmt::format("{}=\"{}\" is after the end of the run ({})", attribute,
+                                e->Attribute(attribute), end));
+}
+
+Status checkWithinRun(const Reader& r, const XMLElement* e, const Scenario& s,
+                      const TimedAction& a) {
+  const RunEnd end = runEnd(s);
+  const std::string duration = "durationMs=" + msText(end.duration) + " after time zero";
+  if (end.external) {
+    if (a.time && *a.time > end.duration) return afterTheEnd(r, e, "timeMs", duration);
+    return okStatus();
+  }
+  if (a.cycle && *a.cycle >= end.cycles) {
+    return afterTheEnd(r, e, "cycle", fmt::format("its last cycle is {}", end.cycles - 1));
+  }
+  if (a.time && *a.time > end.lastCycleStart) {
+    return afterTheEnd(r, e, "timeMs",
+                       "its last cycle starts at " + msText(end.lastCycleStart) + " ms");
+  }
+  return okStatus();
+}
+
+Status checkWithinRun(const Reader& r, const XMLElement* e, const Scenario& s,
+                      const Expectation& x) {
+  const RunEnd end = runEnd(s);
+  const std::string duration = "durationMs=" + msText(end.duration);
+  const std::string cycles = fmt::format("{} cycles", end.cycles);
+  if (x.atTime && *x.atTime > end.duration) return afterTheEnd(r, e, "atMs", duration);
+  if (x.afterTime && *x.afterTime > end.duration) return afterTheEnd(r, e, "afterMs", duration);
+  if (end.external) return okStatus();
+  if (x.atCycle && *x.atCycle > end.cycles) return afterTheEnd(r, e, "cycle", cycles);
+  const bool window = x.kind == ExpectKind::kDetected || x.kind == ExpectKind::kBackInOp;
+  if (window && e->Attribute("afterCycle") != nullptr && x.afterCycle >= end.cycles) {
+    return afterTheEnd(r, e, "afterCycle", fmt::format("its last cycle is {}", end.cycles - 1));
+  }
+  return okStatus();
+}
+
 }  // namespace
 
 std::string_view toString(Compare c) {
@@ -319,23 +438,51 @@ bool compareValues(double observed, Compare c, double expected, double tolerance
 
 Result<Scenario> loadScenario(const std::filesystem::path& path) {
   ECSIM_ASSIGN_OR_RETURN(const std::string text, readRegularFile(path, kMaxXmlFileBytes));
-  return parseScenario(text, path);
+  ECSIM_ASSIGN_OR_RETURN(Scenario s, parseScenario(text, path));
+  auto topology = loadTopologyFile(s.topology);
+  if (!topology.ok()) {
+    return makeError(topology.error().code,
+                     fmt::format("{}, line {}: topology=\"{}\": {}", path.string(), s.line,
+                                 s.topology.filename().string(), topology.error().context));
+  }
+  ECSIM_TRY(checkTopologyNames(s, *topology));
+  return s;
+}
+
+Status checkTopologyNames(const Scenario& s, const TopologyConfig& topology) {
+  std::vector<std::string_view> slaves;
+  for (const auto& slave : topology.slaves) slaves.push_back(slave.name);
+  std::vector<std::string_view> cables{"master"};
+  for (const auto& link : topology.links) cables.push_back(link.name);
+  auto check = [&](int line, std::string_view what, std::string_view name,
+                   const std::vector<std::string_view>& names) -> Status {
+    if (std::find(names.begin(), names.end(), name) != names.end()) return okStatus();
+    return makeError(ErrorCode::kParse,
+                     fmt::format("{}, line {}: no {} '{}' in the topology{}", s.file.string(), line,
+                                 what, name, didYouMean(name, names)));
+  };
+  for (const auto& a : s.actions) {
+    if (auto slave = a.action.get("slave")) ECSIM_TRY(check(a.line, "slave", *slave, slaves));
+    if (auto cable = a.action.get("cable")) ECSIM_TRY(check(a.line, "cable", *cable, cables));
+  }
+  for (const auto& x : s.expectations) {
+    if (!x.slave.empty()) ECSIM_TRY(check(x.line, "slave", x.slave, slaves));
+  }
+  return okStatus();
 }
 
 Result<Scenario> parseScenario(std::string_view xml, const std::filesystem::path& path) {
   Reader r(path.string());
   tinyxml2::XMLDocument doc;
-  if (doc.Parse(xml.data(), xml.size()) != tinyxml2::XML_SUCCESS) {
-    return makeError(
-        ErrorCode::kParse,
-        path.string() + ", line " + std::to_string(doc.ErrorLineNum()) + ": " + doc.ErrorStr());
-  }
+  ECSIM_TRY(xml::parseDocument(xml, r.context(), doc));
   const XMLElement* root = doc.RootElement();
   if (root == nullptr || std::string_view(root->Name()) != "Scenario") {
     return r.error(root, "the root element must be <Scenario>");
   }
+  ECSIM_TRY(xml::checkNames(r.context(), root, kScenarioNames));
   Scenario s;
   s.file = path;
+  s.line = root->GetLineNum();
   s.name = Reader::attr(root, "name").value_or(path.stem().string());
   auto topology = Reader::attr(root, "topology");
   if (!topology) return r.error(root, "Scenario needs topology=\"PATH\"");
@@ -348,10 +495,12 @@ Result<Scenario> parseScenario(std::string_view xml, const std::filesystem::path
   if (duration) s.duration = *duration;
   if (s.duration < s.cycleTime) return r.error(root, "durationMs is shorter than one cycle");
   s.seed = seed.value_or(1);
-  if (const auto* d = root->FirstChildElement("Description"); d && d->GetText()) {
-    s.description = d->GetText();
+  if (const auto* d = root->FirstChildElement("Description")) {
+    ECSIM_TRY(xml::checkNames(r.context(), d, kDescriptionNames));
+    if (d->GetText() != nullptr) s.description = d->GetText();
   }
   if (const auto* m = root->FirstChildElement("Master")) {
+    ECSIM_TRY(xml::checkNames(r.context(), m, kMasterNames));
     s.masterKind = Reader::attr(m, "kind").value_or("in-process");
     if (s.masterKind != "in-process" && s.masterKind != "external") {
       return r.error(m, "Master kind must be in-process or external");
@@ -375,17 +524,21 @@ Result<Scenario> parseScenario(std::string_view xml, const std::filesystem::path
     s.timeFromStart = timeZero.value_or("op") == "start";
   }
   if (const auto* t = root->FirstChildElement("Timeline")) {
+    ECSIM_TRY(xml::checkNames(r.context(), t, kTimelineNames));
     for (const auto* e = t->FirstChildElement(); e != nullptr; e = e->NextSiblingElement()) {
       if (std::string_view(e->Name()) != "Action") {
         return r.error(e, "the Timeline holds <Action> elements only");
       }
       ECSIM_ASSIGN_OR_RETURN(auto a, readAction(r, e));
+      ECSIM_TRY(checkWithinRun(r, e, s, a));
       s.actions.push_back(std::move(a));
     }
   }
   if (const auto* x = root->FirstChildElement("Expect")) {
+    ECSIM_TRY(xml::checkNames(r.context(), x, kExpectNames));
     for (const auto* e = x->FirstChildElement(); e != nullptr; e = e->NextSiblingElement()) {
       ECSIM_ASSIGN_OR_RETURN(auto exp, readExpectation(r, e));
+      ECSIM_TRY(checkWithinRun(r, e, s, exp));
       s.expectations.push_back(std::move(exp));
     }
   }

@@ -146,7 +146,8 @@ Result<std::string> encoderFault(const FaultAction& a, slavesim::Slave& slave) {
   } else if (kind == "power") {
     bit = ef::kPower;
   } else if (kind != "data") {
-    return a.error("kind must be data, frame or power");
+    return a.error("kind must be data, frame or power" +
+                   didYouMean(kind, {"data", "frame", "power"}));
   }
   const auto ch = static_cast<unsigned>(channel);
   const std::uint8_t faults = on != 0 ? static_cast<std::uint8_t>(encoder.fault(ch) | bit)
@@ -229,19 +230,29 @@ std::string FaultAction::text() const {
   return out;
 }
 
+std::vector<std::string_view> faultVerbs() {
+  std::vector<std::string_view> verbs;
+  for (const auto& v : kVerbArguments) verbs.push_back(v.verb);
+  return verbs;
+}
+
+std::vector<std::string_view> faultArguments(std::string_view verb) {
+  std::vector<std::string_view> keys;
+  if (const VerbArguments* v = verbArguments(verb)) {
+    for (std::string_view k : v->keys) {
+      if (!k.empty()) keys.push_back(k);
+    }
+  }
+  return keys;
+}
+
 Status checkFaultArguments(const FaultAction& action) {
-  const VerbArguments* verb = verbArguments(action.verb);
-  if (verb == nullptr) {
-    std::vector<std::string_view> verbs;
-    for (const auto& v : kVerbArguments) verbs.push_back(v.verb);
+  if (verbArguments(action.verb) == nullptr) {
     return makeError(ErrorCode::kInvalidArgument,
                      (action.where.empty() ? std::string() : action.where + ": ") +
-                         unknownNameText("action", action.verb, verbs));
+                         unknownNameText("action", action.verb, faultVerbs()));
   }
-  std::vector<std::string_view> keys;
-  for (std::string_view k : verb->keys) {
-    if (!k.empty()) keys.push_back(k);
-  }
+  const std::vector<std::string_view> keys = faultArguments(action.verb);
   for (const auto& [key, value] : action.args) {
     if (std::find(keys.begin(), keys.end(), key) == keys.end()) {
       return action.error(unknownNameText("argument", key, keys));
@@ -320,7 +331,10 @@ Result<std::size_t> FaultInjector::slaveIndex(std::string_view name) const {
   for (std::size_t i = 0; i < segment_.size(); ++i) {
     if (segment_.slave(i).name() == name) return i;
   }
-  return makeError(ErrorCode::kNotFound, "no slave named '" + std::string(name) + "'");
+  std::vector<std::string_view> names;
+  for (std::size_t i = 0; i < segment_.size(); ++i) names.push_back(segment_.slave(i).name());
+  return makeError(ErrorCode::kNotFound,
+                   "no slave named '" + std::string(name) + "'" + didYouMean(name, names));
 }
 
 std::optional<FaultInjector::End> FaultInjector::peer(End end) const {
@@ -332,7 +346,11 @@ std::optional<FaultInjector::End> FaultInjector::peer(End end) const {
 Result<FaultInjector::End> FaultInjector::cableEnd(const FaultAction& action) const {
   if (auto name = action.get("cable")) {
     const CableRef* c = network_.findCable(*name);
-    if (c == nullptr) return action.error("no cable named '" + std::string(*name) + "'");
+    if (c == nullptr) {
+      std::vector<std::string_view> names;
+      for (const auto& cable : network_.cables) names.push_back(cable.name);
+      return action.error("no cable named '" + std::string(*name) + "'" + didYouMean(*name, names));
+    }
     return End{c->slave, c->port};
   }
   if (auto slave = action.get("slave")) {
@@ -536,7 +554,10 @@ Result<std::string> FaultInjector::apply(const FaultAction& a, SimTime now) {
     AlState target = std::min(slave.state(), AlState::kSafeOp);
     if (auto st = a.get("state")) {
       auto parsed = stateFromName(*st);
-      if (!parsed) return a.error("state must be INIT, PREOP, SAFEOP or OP");
+      if (!parsed) {
+        return a.error("state must be INIT, PREOP, SAFEOP or OP" +
+                       didYouMean(*st, {"INIT", "PREOP", "SAFEOP", "OP"}));
+      }
       target = *parsed;
     }
     slave.stateMachine().raiseError(slave.esc(), target, static_cast<std::uint16_t>(code));

@@ -105,6 +105,9 @@ Result<FaultAction> parseFaultAction(std::string_view line);
 // An unknown verb, or an argument the verb does not take, is an error naming the closest valid
 // name (or listing the valid ones).
 Status checkFaultArguments(const FaultAction& action);
+// The verbs FaultInjector applies; the arguments a verb takes (empty for an unknown verb).
+std::vector<std::string_view> faultVerbs();
+std::vector<std::string_view> faultArguments(std::string_view verb);
 // Decimal or 0x-prefixed hexadecimal.
 std::optional<std::uint64_t> parseNumber(std::string_view text);
 

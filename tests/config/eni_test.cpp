@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "config/master_config.hpp"
+#include "config/xml_util.hpp"
 
 namespace ecsim {
 namespace {
@@ -192,6 +193,48 @@ TEST(EniTest, MoreSlavesThanTheAddressSpaceAreRefused) {
   EXPECT_NE(over.error().context.find("big.xml, line 65539: more than 65535 slaves"),
             std::string::npos)
       << over.error().context;
+}
+
+// The tolerant variant of the names check (vendor formats): every finding is a warning with file
+// and line, in document order, and nothing stops; the strict one stops at the first as an error.
+TEST(XmlNames, WarningsListEveryFindingTheStrictCheckStopsAtTheFirst) {
+  tinyxml2::XMLDocument doc;
+  const xml::Context parse("v.xml");
+  ASSERT_TRUE(
+      xml::parseDocument("<Device Typ=\"1\">\n<Nmae/>\n<Info/>\n<Info/>\n</Device>\n", parse, doc)
+          .ok());
+  const xml::Names names{{"Type"}, {"Name", "Info"}, {"Info"}};
+  std::vector<std::string> warnings;
+  xml::warnUnknownNames(xml::Context("v.xml", &warnings), doc.RootElement(), names);
+  EXPECT_EQ(warnings,
+            (std::vector<std::string>{
+                "v.xml, line 1: unknown attribute 'Typ' on <Device>; did you mean 'Type'?",
+                "v.xml, line 2: unknown element <Nmae> in <Device>; did you mean <Name>?",
+                "v.xml, line 4: second <Info> in <Device> (it takes one)"}));
+  auto strict = xml::checkNames(parse, doc.RootElement(), names);
+  ASSERT_FALSE(strict.ok());
+  EXPECT_EQ(strict.error().context, warnings[0]);
+}
+
+// Issue #16: what the reader drops and a master would need is a warning with file and line:
+// init commands of a mailbox protocol other than CoE (ETG.2100 Mailbox/SoE|EoE|.../InitCmds).
+// Other children the reader does not take (vendor extensions) give none.
+TEST(EniTest, DroppedInitCommandsOfOtherMailboxProtocolsAreWarnedAbout) {
+  const std::string mailbox =
+      "<Mailbox><Send><Start>4096</Start><Length>128</Length></Send>\n"
+      "<Recv><Start>4224</Start><Length>128</Length></Recv>\n"
+      "<Protocol>SoE</Protocol><VendorExtension/>\n"
+      "<SoE>\n<InitCmds>\n<InitCmd><Transition>PS</Transition></InitCmd>\n"
+      "<InitCmd><Transition>PS</Transition></InitCmd>\n</InitCmds>\n</SoE>\n</Mailbox>\n";
+  auto eni = parseEni(eniWith("<Slave>\n" + kInfo + mailbox + "</Slave>\n"), "soe.xml");
+  ASSERT_TRUE(eni.ok()) << eni.error().message();
+  ASSERT_EQ(eni->warnings.size(), 1u);
+  EXPECT_EQ(eni->warnings[0],
+            "soe.xml, line 10: 2 <SoE> init command(s) ignored: only CoE init commands are sent");
+  auto plain =
+      parseEni(eniWith("<Slave>\n" + kInfo + "<Vendor><X/></Vendor>\n</Slave>\n"), "plain.xml");
+  ASSERT_TRUE(plain.ok()) << plain.error().message();
+  EXPECT_TRUE(plain->warnings.empty());
 }
 
 // Issue #21: cycle times are bounded; vendor files are tolerant, so an absurd one is a warning

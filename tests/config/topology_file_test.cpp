@@ -152,7 +152,7 @@ INSTANTIATE_TEST_SUITE_P(
                 "line 3: Module needs either type"},
         BadCase{"<Topology>\n<Slave name=\"A\" esi=\"h.xml\" product=\"1\">\n"
                 "<Module type=\"X\" idents=\"1\"/>\n</Slave>\n</Topology>",
-                "line 3: unknown Module attribute 'idents'; did you mean 'ident'?"},
+                "line 3: unknown attribute 'idents' on <Module>; did you mean 'ident'?"},
         BadCase{"<Topology>\n<Slave name=\"A\">\n<Module type=\"X\"/>\n</Slave>\n</Topology>",
                 "line 2: Slave 'A': modules need a device from an ESI file"}));
 

@@ -22,7 +22,7 @@ const std::filesystem::path kDir = std::filesystem::path(ECSIM_SOURCE_DIR) / "sc
 // Line 1 is the XML declaration, line 2 <Scenario>, line 3 <Master>, the body from line 4.
 std::string wrap(const std::string& master, const std::string& body) {
   return "<?xml version=\"1.0\"?>\n<Scenario name=\"t\" topology=\"demo.xml\" "
-         "durationMs=\"100\">\n" +
+         "durationMs=\"5000\">\n" +
          master + "\n" + body + "</Scenario>\n";
 }
 
