@@ -99,7 +99,10 @@ int runSlaves(const GlobalOptions& g, bool verbose) {
   for (const auto& s : slaves) {
     fmt::print("{:3}  {}  {:<12} vendor {} product {} rev {}  {}\n", s.position, hex(s.station, 4),
                master::describeAlStatus(s.alStatus), hex(s.identity().vendorId, 8),
-               hex(s.identity().productCode, 8), hex(s.identity().revision, 8), s.displayName());
+               hex(s.identity().productCode, 8), hex(s.identity().revision, 8),
+               s.configuredName.empty() || s.configuredName == s.name
+                   ? s.displayName()
+                   : s.configuredName + " (" + s.name + ")");
     if (!verbose) continue;
     fmt::print("       ESC type {} rev {} build {}, {} FMMUs, {} SMs, {} KB RAM{}\n",
                hex(s.escType, 2), s.escRevision, s.escBuild, s.fmmuCount, s.syncManagerCount,
