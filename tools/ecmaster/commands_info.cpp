@@ -50,6 +50,11 @@ Result<std::unique_ptr<Connection>> connectAndScan(const GlobalOptions& global, 
     connection->master().setSlaveNames(connection->simulatedNames());
   }
   ECSIM_TRY(connection->master().scan());
+  const std::size_t named = connection->master().slaveNames().size();
+  if (!global.names.empty() && named != connection->master().slaves().size()) {
+    fmt::print(stderr, "ecmaster: warning: {} names {} slaves, the bus has {}\n", global.names,
+               named, connection->master().slaves().size());
+  }
   if (const auto& config = connection->master().config()) {
     ECSIM_TRY(master::checkIdentities(*config, connection->master().slaves(),
                                       connection->master().options().identity));
