@@ -49,7 +49,8 @@ Status checkIdentities(const MasterConfig& config, const std::vector<SlaveInfo>&
     // The name the slave's SII gives, beside the one it is configured under.
     char found[48];
     std::snprintf(found, sizeof found, "slave %zu (0x%04X", slaves[i].position, slaves[i].station);
-    std::string who = std::string(found) + (slaves[i].name.empty() ? "" : " '" + slaves[i].name + "'") + ")";
+    std::string who =
+        std::string(found) + (slaves[i].name.empty() ? "" : " '" + slaves[i].name + "'") + ")";
     std::string expected = want.name.empty() ? "" : " configured as '" + want.name + "'";
     context += (context.empty() ? "" : "; ") + who + expected + ", " + config.file + " line " +
                std::to_string(want.line) + ": " + diff;

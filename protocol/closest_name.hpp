@@ -51,10 +51,12 @@ inline std::vector<std::string_view> closestNames(std::string_view name,
                                                   std::size_t count) {
   std::vector<std::pair<std::size_t, std::size_t>> ranked;  // distance, index
   ranked.reserve(names.size());
-  for (std::size_t i = 0; i < names.size(); ++i) ranked.emplace_back(editDistance(name, names[i]), i);
+  for (std::size_t i = 0; i < names.size(); ++i)
+    ranked.emplace_back(editDistance(name, names[i]), i);
   std::stable_sort(ranked.begin(), ranked.end());
   std::vector<std::string_view> out;
-  for (std::size_t i = 0; i < ranked.size() && i < count; ++i) out.push_back(names[ranked[i].second]);
+  for (std::size_t i = 0; i < ranked.size() && i < count; ++i)
+    out.push_back(names[ranked[i].second]);
   return out;
 }
 

@@ -92,9 +92,10 @@ Result<std::vector<std::string>> loadSlaveNames(const std::filesystem::path& fil
     for (const ExpectedSlave& s : config.slaves) names.push_back(s.name);
     return names;
   }
-  return makeError(ErrorCode::kInvalidArgument,
-                   file.string() + ": root element <" + root +
-                       "> names no slaves (a <Topology>, an ENI <EtherCATConfig> or an <EcsimMaster> does)");
+  return makeError(
+      ErrorCode::kInvalidArgument,
+      file.string() + ": root element <" + root +
+          "> names no slaves (a <Topology>, an ENI <EtherCATConfig> or an <EcsimMaster> does)");
 }
 
 }  // namespace ecsim::topology

@@ -62,8 +62,7 @@ TEST_F(SlaveNames, TreeOrderIsTheOrderTheMasterScans) {
 TEST_F(SlaveNames, AnEniGivesItsSlavesNamesInTheOrderWritten) {
   auto names = topology::loadSlaveNames(ECSIM_SOURCE_DIR "/examples/eni/demo-eni.xml");
   ASSERT_TRUE(names.ok()) << names.error().message();
-  EXPECT_EQ(*names,
-            (std::vector<std::string>{"Coupler", "DI1", "DO1", "AI1", "Drive1", "Drive2"}));
+  EXPECT_EQ(*names, (std::vector<std::string>{"Coupler", "DI1", "DO1", "AI1", "Drive1", "Drive2"}));
   auto demo = topology::loadSlaveNames(ECSIM_SOURCE_DIR "/examples/topologies/demo.xml");
   ASSERT_TRUE(demo.ok()) << demo.error().message();
   EXPECT_EQ(*demo, *names);
@@ -73,10 +72,8 @@ TEST_F(SlaveNames, AFileThatNamesNoSlavesIsRefusedNamingIt) {
   const auto file = write("slave_names_scenario.xml", "<Scenario name=\"x\"/>\n");
   auto names = topology::loadSlaveNames(file);
   ASSERT_FALSE(names.ok());
-  EXPECT_NE(names.error().context.find(file.string()), std::string::npos)
-      << names.error().context;
-  EXPECT_NE(names.error().context.find("<Scenario>"), std::string::npos)
-      << names.error().context;
+  EXPECT_NE(names.error().context.find(file.string()), std::string::npos) << names.error().context;
+  EXPECT_NE(names.error().context.find("<Scenario>"), std::string::npos) << names.error().context;
   EXPECT_FALSE(topology::loadSlaveNames("/nonexistent/names.xml").ok());
 }
 

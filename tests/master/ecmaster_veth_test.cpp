@@ -83,8 +83,8 @@ TEST(EcmasterVeth, EniOfAScanConfiguresTheBusServedFromIt) {
   ASSERT_TRUE(ns.ok()) << ns.error().message();
   const std::string log = uniqueTempPath("ecmaster_veth_round_trip.log");
   const std::string eni = uniqueTempPath("ecmaster_veth_round_trip_eni.xml");
-  const std::vector<std::string> base{kEcmaster, "--iface", ns->masterInterface(),
-                                      "--timeout-ms", "20"};
+  const std::vector<std::string> base{kEcmaster, "--iface", ns->masterInterface(), "--timeout-ms",
+                                      "20"};
   auto ecmaster = [&](std::vector<std::string> args) {
     args.insert(args.begin(), base.begin(), base.end());
     auto out = ns->run(args);
@@ -107,11 +107,10 @@ TEST(EcmasterVeth, EniOfAScanConfiguresTheBusServedFromIt) {
   auto fromEni = serve(eni, eniLog);
   ASSERT_TRUE(fromEni.ok()) << fromEni.error().message();
   ASSERT_TRUE(waitForText(eniLog, "ecsim: serving", *fromEni)) << readWholeFile(eniLog);
-  auto configured = ecmaster({"--config", eni, "cyclic", "--cycle-us", "2000", "--seconds",
-                              "0.5", "--quiet", "--show", "Drive1.Statusword"});
+  auto configured = ecmaster({"--config", eni, "cyclic", "--cycle-us", "2000", "--seconds", "0.5",
+                              "--quiet", "--show", "Drive1.Statusword"});
   EXPECT_EQ(configured.exitCode, 0) << configured.output << readWholeFile(eniLog);
-  EXPECT_NE(configured.output.find("Drive1.Statusword = "), std::string::npos)
-      << configured.output;
+  EXPECT_NE(configured.output.find("Drive1.Statusword = "), std::string::npos) << configured.output;
   auto strict = ecmaster({"--config", eni, "--check-serial", "slaves"});
   EXPECT_EQ(strict.exitCode, 1) << strict.output;
   EXPECT_NE(strict.output.find("serial"), std::string::npos) << strict.output;

@@ -4,9 +4,9 @@
 #include <iostream>
 
 #include "protocol/registers.hpp"
-#include "topology/slave_names.hpp"
 #include "tools/ecmaster/commands.hpp"
 #include "tools/ecmaster/values.hpp"
+#include "topology/slave_names.hpp"
 
 namespace ecsim::tools::ecmaster {
 
