@@ -24,7 +24,8 @@ bool hasTransition(const std::vector<EniTransition>& list, char from, char to) {
 
 }  // namespace
 
-Status checkIdentities(const MasterConfig& config, const std::vector<SlaveInfo>& slaves) {
+Status checkIdentities(const MasterConfig& config, const std::vector<SlaveInfo>& slaves,
+                       IdentityCheck check) {
   if (config.slaves.size() != slaves.size()) {
     return makeError(ErrorCode::kNotFound,
                      config.file + " expects " + std::to_string(config.slaves.size()) +
@@ -43,11 +44,16 @@ Status checkIdentities(const MasterConfig& config, const std::vector<SlaveInfo>&
     compare("vendor", want.vendorId, have.vendorId);
     compare("product code", want.productCode, have.productCode);
     if (want.revision) compare("revision", *want.revision, have.revision);
-    if (want.serial) compare("serial", *want.serial, have.serial);
+    if (want.serial && check.serial) compare("serial", *want.serial, have.serial);
     if (diff.empty()) continue;
+    // The name the slave's SII gives, beside the one it is configured under.
+    char found[48];
+    std::snprintf(found, sizeof found, "slave %zu (0x%04X", slaves[i].position, slaves[i].station);
+    std::string who =
+        std::string(found) + (slaves[i].name.empty() ? "" : " '" + slaves[i].name + "'") + ")";
     std::string expected = want.name.empty() ? "" : " configured as '" + want.name + "'";
-    context += (context.empty() ? "" : "; ") + slaves[i].label() + expected + ", " + config.file +
-               " line " + std::to_string(want.line) + ": " + diff;
+    context += (context.empty() ? "" : "; ") + who + expected + ", " + config.file + " line " +
+               std::to_string(want.line) + ": " + diff;
   }
   if (context.empty()) return okStatus();
   return makeError(ErrorCode::kInvalidArgument, "identity mismatch: " + context);

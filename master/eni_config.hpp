@@ -22,10 +22,19 @@ using ecsim::loadMasterConfig;
 using ecsim::MasterConfig;
 using ecsim::parseMasterConfig;
 
+// What checkIdentities compares. Vendor ID and product code always, the revision where the
+// configuration gives one; the serial number only when asked, as IgH (a slave configuration
+// names vendor and product) and TwinCAT (serial number check off unless enabled) do, so an
+// ENI exported from one bus configures another bus of the same devices.
+struct IdentityCheck {
+  bool serial{false};
+};
+
 // Compares the bus with the configuration: kNotFound when the slave counts differ,
 // kInvalidArgument naming each slave whose identity differs (position, station, what was
 // expected and found, the configuration file and line).
-Status checkIdentities(const MasterConfig& config, const std::vector<SlaveInfo>& slaves);
+Status checkIdentities(const MasterConfig& config, const std::vector<SlaveInfo>& slaves,
+                       IdentityCheck check = {});
 
 // The AL state letter an ENI transition uses (I, P, B, S, O).
 char eniStateLetter(AlState state);

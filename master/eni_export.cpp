@@ -111,7 +111,7 @@ EniConfig eniFromMaster(const Master& master) {
   for (const SlaveInfo& s : slaves) {
     EniSlave e;
     e.line = 0;
-    e.name = s.name.empty() ? "slave " + std::to_string(s.position) : s.name;
+    e.name = s.displayName().empty() ? "slave " + std::to_string(s.position) : s.displayName();
     e.physAddr = s.station;
     e.autoIncAddr = -static_cast<std::int32_t>(s.position);
     e.vendorId = s.identity().vendorId;

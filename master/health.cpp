@@ -78,7 +78,7 @@ HealthMonitor::HealthMonitor(Transport& transport, std::vector<SlaveInfo>& slave
     SlaveHealth& h = slaves_[i].health;
     h.position = slaves[i].position;
     h.station = slaves[i].station;
-    h.name = slaves[i].name;
+    h.name = slaves[i].displayName();
     h.alStatus = slaves[i].alStatus;
     h.alStatusCode = slaves[i].alStatusCode;
   }

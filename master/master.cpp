@@ -125,7 +125,26 @@ Status Master::scan() {
   ScanTask task(transport_, slaves_, options_.scan);
   task.start(bus_.now());
   ECSIM_TRY(run(task, options_.scanTimeout, "scan"));
-  return task.status();
+  ECSIM_TRY(task.status());
+  applySlaveNames();
+  return okStatus();
+}
+
+void Master::setSlaveNames(std::vector<std::string> names) {
+  slaveNames_ = std::move(names);
+  applySlaveNames();
+}
+
+void Master::applySlaveNames() {
+  for (auto& slave : slaves_) {
+    const std::size_t i = slave.position;
+    slave.configuredName.clear();
+    if (i < slaveNames_.size() && !slaveNames_[i].empty()) {
+      slave.configuredName = slaveNames_[i];
+    } else if (config_ && i < config_->slaves.size()) {
+      slave.configuredName = config_->slaves[i].name;
+    }
+  }
 }
 
 Status Master::setupMailboxes() {
@@ -187,6 +206,7 @@ Status Master::requestState(AlState target) {
 }
 
 Status Master::configureProcessData() {
+  applySlaveNames();  // a configuration set after the scan names the slaves too
   ECSIM_TRY(runInitCommands(AlState::kSafeOp, InitPhase::kBefore));  // PDO assignment first
   processData_.assign(slaves_.size(), {});
   std::vector<std::unique_ptr<PdoDiscoveryTask>> discoveries(slaves_.size());
@@ -235,11 +255,7 @@ Status Master::configureProcessData() {
       std::make_unique<MasterSlaveSetup>(processData_, config_, &dc_, &slaves_,
                                          options_.dc.recoverySync0Margin),
       options_.mailbox);
-  std::vector<std::string> names;  // the configuration's names, else the SII's
-  if (config_) {
-    for (const auto& expected : config_->slaves) names.push_back(expected.name);
-  }
-  variables_ = nameVariables(layout_, slaves_, names);
+  variables_ = nameVariables(layout_, slaves_);
   if (config_ && config_->eni && !config_->eni->cyclic.empty()) {
     ECSIM_TRY(addEniVariables(variables_, *config_->eni, layout_));  // the ENI's names too
   }
@@ -275,7 +291,7 @@ Status Master::bringTo(AlState target) {
 
 Status Master::start() {
   ECSIM_TRY(scan());
-  if (config_) ECSIM_TRY(checkIdentities(*config_, slaves_));
+  if (config_) ECSIM_TRY(checkIdentities(*config_, slaves_, options_.identity));
   if (slaves_.empty()) return makeError(ErrorCode::kNotFound, "no slaves found");
   ECSIM_TRY(applyEniSetup());
   if (options_.dc.enable) ECSIM_TRY(initDc());

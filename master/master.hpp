@@ -60,6 +60,8 @@ struct MasterOptions {
   // nothing is read or reconfigured and every missing working counter is a WKC error.
   bool recovery{true};
   HealthOptions health;
+  // What start() compares against a loaded configuration (serial numbers: off by default).
+  IdentityCheck identity;
 };
 
 class Master {
@@ -71,6 +73,11 @@ class Master {
   Status loadConfig(const std::filesystem::path& path);
   void setConfig(MasterConfig config) { config_ = std::move(config); }
   const std::optional<MasterConfig>& config() const { return config_; }
+  // The slaves' names by bus position (a topology's or ENI's, topology/slave_names.hpp), for
+  // variables, events and messages (SlaveInfo::configuredName). They win over the names of a
+  // configuration; an empty or missing entry leaves that slave to the configuration or its SII.
+  void setSlaveNames(std::vector<std::string> names);
+  const std::vector<std::string>& slaveNames() const { return slaveNames_; }
 
   Status start();
   // Copies into the outputs of the process image (offset < layout().outputBytes).
@@ -182,11 +189,14 @@ class Master {
   enum class InitPhase { kBefore, kAfter };
   Status applyEniSetup();
   Status runInitCommands(AlState target, InitPhase phase);
+  // Sets each scanned slave's configuredName from slaveNames_, else the configuration.
+  void applySlaveNames();
 
   MasterOptions options_;
   Transport transport_;
   Bus& bus_;
   std::optional<MasterConfig> config_;
+  std::vector<std::string> slaveNames_;
   std::vector<SlaveInfo> slaves_;
   std::vector<SlaveProcessData> processData_;
   ProcessImageLayout layout_;

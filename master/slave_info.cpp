@@ -8,7 +8,7 @@ std::string SlaveInfo::label() const {
   char buf[32];
   std::snprintf(buf, sizeof buf, "slave %zu (0x%04X", position, station);
   std::string s = buf;
-  if (!name.empty()) s += " '" + name + "'";
+  if (!displayName().empty()) s += " '" + displayName() + "'";
   return s + ")";
 }
 

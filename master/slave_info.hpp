@@ -52,6 +52,9 @@ struct SlaveInfo {
   SiiContents siiContents;
   std::optional<Error> siiDamage;  // the category scan stopped here (lenient parse)
   std::string name;
+  // The name the configuration gives the slave (a topology's or ENI's slave name, "Drive1"),
+  // empty when none does: variables, events and messages use it before the SII's.
+  std::string configuredName;
   std::optional<MailboxConfig> mailbox;
   // Run-time
   std::uint8_t mailboxCounter{0};  // last counter used (1..7)
@@ -64,7 +67,9 @@ struct SlaveInfo {
   }
   std::optional<AlState> state() const { return alStateFromRaw(alStatus); }
   bool alError() const { return (alStatus & kAlErrorFlag) != 0; }
-  // "slave 2 (0x1003 'DO1')"
+  // configuredName, else the SII's name.
+  const std::string& displayName() const { return configuredName.empty() ? name : configuredName; }
+  // "slave 2 (0x1003 'DO1')", by displayName().
   std::string label() const;
 };
 

@@ -136,7 +136,7 @@ bool StateChangeTask::step(SimTime now) {
           StateRefusal r;
           r.position = position;
           r.station = slave.station;
-          r.name = slave.name;
+          r.name = slave.displayName();
           r.requested = target_;
           r.alStatus = slave.alStatus;
           r.alStatusCode = slave.alStatusCode;

@@ -4,10 +4,14 @@
 #include <cstdio>
 #include <map>
 
+#include "protocol/closest_name.hpp"
 #include "protocol/coe.hpp"
 
 namespace ecsim::master {
 namespace {
+
+// How many of the nearest names an unknown variable's error lists.
+constexpr std::size_t kClosestListed = 4;
 
 std::string hexIndex(std::uint16_t index, std::uint8_t subindex) {
   char buf[16];
@@ -194,13 +198,12 @@ std::string PdoVariable::format() const {
 }
 
 std::vector<VariableInfo> nameVariables(const ProcessImageLayout& layout,
-                                        const std::vector<SlaveInfo>& slaves,
-                                        const std::vector<std::string>& slaveNames) {
+                                        const std::vector<SlaveInfo>& slaves) {
   // Slave names, made unique.
   std::vector<std::string> names(slaves.size());
   std::map<std::string, int> uses;
   for (std::size_t i = 0; i < slaves.size(); ++i) {
-    names[i] = i < slaveNames.size() && !slaveNames[i].empty() ? slaveNames[i] : siiName(slaves[i]);
+    names[i] = slaves[i].configuredName.empty() ? siiName(slaves[i]) : slaves[i].configuredName;
     if (names[i].empty()) names[i] = "Slave" + std::to_string(i);
     ++uses[names[i]];
   }
@@ -260,15 +263,13 @@ Result<VariableInfo> findVariable(const std::vector<VariableInfo>& variables,
       return v;
     }
   }
+  std::vector<std::string_view> names;
+  names.reserve(variables.size());
+  for (const auto& v : variables) names.push_back(v.name);
   std::string hint;
-  const auto dot = name.find('.');
-  const std::string_view slave = name.substr(0, dot);
-  std::size_t listed = 0;
-  for (const auto& v : variables) {
-    if (v.slave != slave || listed >= 8) continue;
-    hint += (listed++ == 0 ? "; " + std::string(slave) + " has " : ", ") + v.name;
+  for (std::string_view close : closestNames(name, names, kClosestListed)) {
+    hint += (hint.empty() ? "; closest: " : ", ") + std::string(close);
   }
-  if (listed == 0 && !variables.empty()) hint = "; e.g. " + variables.front().name;
   return makeError(ErrorCode::kNotFound, "no process variable '" + std::string(name) + "'" + hint);
 }
 

@@ -2,7 +2,8 @@
 // "<slave>.<entry>" ("Drive1.Statusword", "DI1.Input 3"), like the pins of a LinuxCNC HAL
 // component, with typed access to the bits it occupies in the process image.
 //
-//   slave  the name the configuration gives the slave, else its SII order string ("ECS1008")
+//   slave  the name the configuration gives the slave (SlaveInfo::configuredName: a topology's
+//          or ENI's slave name, Master::setSlaveNames), else its SII order string ("ECS1008")
 //          or, without one, its SII device name; when several
 //          slaves share a name, each is "<name>_<position>"; "<position>" always works too
 //   entry  the entry's name (PDO entry name from the SII or dictionary); when a slave has two
@@ -106,12 +107,11 @@ class PdoVariable {
   std::vector<std::uint8_t>* image_;
 };
 
-// Every entry of the layout, named as above. slaveNames[i] overrides the name of slave i
-// when not empty.
+// Every entry of the layout, named as above.
 std::vector<VariableInfo> nameVariables(const ProcessImageLayout& layout,
-                                        const std::vector<SlaveInfo>& slaves,
-                                        const std::vector<std::string>& slaveNames = {});
-// Finds `name` (or an alias as above) among `variables`; kNotFound lists close candidates.
+                                        const std::vector<SlaveInfo>& slaves);
+// Finds `name` (or an alias as above) among `variables`; kNotFound names the closest variables
+// ("no process variable 'Drive1.StatusWord'; closest: Drive1.Statusword, Drive2.Statusword").
 Result<VariableInfo> findVariable(const std::vector<VariableInfo>& variables,
                                   std::string_view name);
 

@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace ecsim {
@@ -60,6 +61,22 @@ inline std::optional<std::string_view> closestName(std::string_view name,
 inline std::string didYouMean(std::string_view name, const std::vector<std::string_view>& names) {
   if (auto best = closestName(name, names)) return "; did you mean '" + std::string(*best) + "'?";
   return {};
+}
+
+// The `count` names in `names` nearest to `name`, nearest first (in their given order among
+// equally near ones), however far: for lists of candidates ("closest: Drive1.Statusword, ...").
+inline std::vector<std::string_view> closestNames(std::string_view name,
+                                                  const std::vector<std::string_view>& names,
+                                                  std::size_t count) {
+  std::vector<std::pair<std::size_t, std::size_t>> ranked;  // distance, index
+  ranked.reserve(names.size());
+  for (std::size_t i = 0; i < names.size(); ++i)
+    ranked.emplace_back(editDistance(name, names[i]), i);
+  std::stable_sort(ranked.begin(), ranked.end());
+  std::vector<std::string_view> out;
+  for (std::size_t i = 0; i < ranked.size() && i < count; ++i)
+    out.push_back(names[ranked[i].second]);
+  return out;
 }
 
 // "unknown argument 'durationMS'; did you mean 'durationMs'?" when one is close, else

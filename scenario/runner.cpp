@@ -18,6 +18,7 @@
 #include "topology/network_builder.hpp"
 #include "topology/network_server.hpp"
 #include "topology/pcap_cable_tap.hpp"
+#include "topology/slave_names.hpp"
 
 namespace ecsim::scenario {
 namespace {
@@ -416,6 +417,8 @@ ScenarioResult Run::execute() {
   mo.cycleTime = s_.cycleTime;
   mo.recovery = o_.recovery;
   master_ = std::make_unique<master::Master>(masterEnd, bus, mo);
+  // Its events and messages name the slaves as the topology does ("slave 5 (0x1006 'Drive2')").
+  master_->setSlaveNames(topology::slaveNamesInBusOrder(segment));
   struct ResetFirst {  // the master goes before the link and bus it uses, on every return
     std::unique_ptr<master::Master>& master;
     ~ResetFirst() { master.reset(); }

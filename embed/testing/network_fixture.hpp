@@ -6,6 +6,7 @@
 //     ASSERT_TRUE(startInProcess("demo.xml").ok());   // MemoryLink, virtual time, our master
 //     ASSERT_TRUE(master().start().ok());
 //     EXPECT_EQ(network().slave("DO1")->state(), ecsim::AlState::kOp);
+//     auto status = master().variable("Drive1.Statusword");   // named as the topology names
 //   }
 //
 // In process: the network and (optionally) ecsim's master meet over a MemoryLink, the master's
@@ -35,6 +36,7 @@
 #include "master/bus.hpp"
 #include "master/master.hpp"
 #include "protocol/result.hpp"
+#include "topology/slave_names.hpp"
 
 namespace ecsim::testing {
 
@@ -63,6 +65,7 @@ class NetworkFixture : public ::testing::Test {
       bus_ = std::make_unique<master::VirtualBus>(*network_->virtualClock(),
                                                   [net](SimTime) { return net->serveOne(); });
       master_ = std::make_unique<master::Master>(*masterLink_, *bus_, options.master);
+      nameSlaves();
     }
     return okStatus();
   }
@@ -90,6 +93,7 @@ class NetworkFixture : public ::testing::Test {
       masterLink_ = std::make_unique<RawSocketLink>(std::move(masterEnd));
       bus_ = std::make_unique<master::RealTimeBus>(*masterLink_, realClock_);
       master_ = std::make_unique<master::Master>(*masterLink_, *bus_, options.master);
+      nameSlaves();
     }
     stop_ = false;
     server_ =
@@ -127,6 +131,10 @@ class NetworkFixture : public ::testing::Test {
   }
 
  private:
+  // Our master names the slaves as the topology does (its variables are "Drive1.Statusword",
+  // its events "slave 4 (0x1005 'Drive1') lost"), by bus position.
+  void nameSlaves() { master_->setSlaveNames(topology::slaveNamesInBusOrder(network_->segment())); }
+
   std::unique_ptr<embed::SimulatedNetwork> network_;
   std::optional<VethNamespace> veth_;
   std::unique_ptr<Link> masterLink_;

@@ -34,7 +34,7 @@ TEST(EcmasterTool, SlavesListsTheDemoNetwork) {
   auto out = run({"--sim", kDemo, "slaves"});
   ASSERT_EQ(out.exitCode, 0) << out.output;
   EXPECT_NE(out.output.find("  0  0x1001  INIT         vendor 0x00000e5c product 0x00001100 "
-                            "rev 0x00010000  ECS1100"),
+                            "rev 0x00010000  Coupler (ECS1100"),
             std::string::npos)
       << out.output;
   EXPECT_NE(out.output.find("  5  0x1006  INIT"), std::string::npos) << out.output;

@@ -145,6 +145,40 @@ TEST_F(DemoVariablesTest, ConfiguredNamesGiveDi1Input3AndDrive1Statusword) {
       << missing.error().context;
 }
 
+// Issue #16 item 3: names by bus position (a topology's, topology/slave_names.hpp) name the
+// variables and the slaves in messages, and win over a configuration's.
+TEST_F(DemoVariablesTest, SlaveNamesNameVariablesAndLabels) {
+  master_->setSlaveNames({"Coupler", "DI1", "DO1", "AI1", "Drive1", "Drive2"});
+  ASSERT_TRUE(master_->start().ok());
+  auto statusword = master_->variable("Drive1.Statusword");
+  ASSERT_TRUE(statusword.ok()) << statusword.error().message() << "\n" << names();
+  EXPECT_EQ(statusword->info().position, static_cast<std::size_t>(kDrive));
+  EXPECT_TRUE(master_->variable("Drive2.Statusword").ok()) << names();
+  EXPECT_FALSE(master_->variable("ECS7201_4.Statusword").ok()) << names();
+  EXPECT_EQ(master_->slaves()[kDrive].label(), "slave 4 (0x1005 'Drive1')");
+  EXPECT_EQ(master_->slaves()[kDrive].name, "ECS7201 CiA 402 servo drive");  // the SII's, kept
+  EXPECT_EQ(master_->health().slaves[kDrive].name, "Drive1");
+}
+
+// An unknown variable lists the nearest names (edit distance), nearest first.
+TEST_F(DemoVariablesTest, AnUnknownVariableListsTheClosestNames) {
+  master_->setSlaveNames({"Coupler", "DI1", "DO1", "AI1", "Drive1", "Drive2"});
+  ASSERT_TRUE(master_->start().ok());
+  auto wrongCase = master_->variable("Drive1.StatusWord");
+  ASSERT_FALSE(wrongCase.ok());
+  EXPECT_EQ(wrongCase.error().code, ErrorCode::kNotFound);
+  EXPECT_EQ(wrongCase.error().context.rfind("no process variable 'Drive1.StatusWord'; closest: "
+                                            "Drive1.Statusword, Drive2.Statusword",
+                                            0),
+            0u)
+      << wrongCase.error().context;
+  auto wrongSlave = master_->variable("Drive3.Statusword");
+  ASSERT_FALSE(wrongSlave.ok());
+  EXPECT_NE(wrongSlave.error().context.find("closest: Drive1.Statusword, Drive2.Statusword"),
+            std::string::npos)
+      << wrongSlave.error().context;
+}
+
 TEST_F(DemoVariablesTest, WithoutConfigurationTheSiiNamesAreMadeUnique) {
   ASSERT_TRUE(master_->start().ok());
   // The SII order strings of examples/esi/ecsim_devices.xml (<Type>); the two drives share

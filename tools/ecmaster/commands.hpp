@@ -19,6 +19,8 @@ struct GlobalOptions {
   ConnectOptions connect;
   bool json{false};
   std::string config;     // --config FILE: expected slaves (identity check)
+  std::string names;      // --names FILE: slave names by bus position (topology or ENI)
+  bool checkSerial{false};  // --check-serial: the identity check compares serial numbers too
   unsigned timeoutMs{2};  // per-frame timeout
 };
 

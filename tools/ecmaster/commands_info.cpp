@@ -6,6 +6,7 @@
 #include "protocol/registers.hpp"
 #include "tools/ecmaster/commands.hpp"
 #include "tools/ecmaster/values.hpp"
+#include "topology/slave_names.hpp"
 
 namespace ecsim::tools::ecmaster {
 
@@ -32,6 +33,7 @@ Result<std::unique_ptr<Connection>> connectAndScan(const GlobalOptions& global, 
   options.scan.resetToDefaults = reset;
   options.recovery = recovery;
   options.transport.timeout = static_cast<SimTime>(global.timeoutMs) * kNsPerMs;
+  options.identity.serial = global.checkSerial;
   ECSIM_ASSIGN_OR_RETURN(auto connection, Connection::open(global.connect, options));
   if (!global.config.empty()) {
     ECSIM_TRY(connection->master().loadConfig(global.config));
@@ -40,9 +42,22 @@ Result<std::unique_ptr<Connection>> connectAndScan(const GlobalOptions& global, 
       for (const auto& w : eni->warnings) fmt::print(stderr, "ecmaster: warning: {}\n", w);
     }
   }
+  // Names: --names FILE, else the simulated network's own (unless --config names them).
+  if (!global.names.empty()) {
+    ECSIM_ASSIGN_OR_RETURN(auto names, topology::loadSlaveNames(global.names));
+    connection->master().setSlaveNames(std::move(names));
+  } else if (connection->simulated() && global.config.empty()) {
+    connection->master().setSlaveNames(connection->simulatedNames());
+  }
   ECSIM_TRY(connection->master().scan());
+  const std::size_t named = connection->master().slaveNames().size();
+  if (!global.names.empty() && named != connection->master().slaves().size()) {
+    fmt::print(stderr, "ecmaster: warning: {} names {} slaves, the bus has {}\n", global.names,
+               named, connection->master().slaves().size());
+  }
   if (const auto& config = connection->master().config()) {
-    ECSIM_TRY(master::checkIdentities(*config, connection->master().slaves()));
+    ECSIM_TRY(master::checkIdentities(*config, connection->master().slaves(),
+                                      connection->master().options().identity));
   }
   return connection;
 }
@@ -58,7 +73,8 @@ nlohmann::json slaveJson(const master::SlaveInfo& s) {
   j["productCode"] = s.identity().productCode;
   j["revision"] = s.identity().revision;
   j["serial"] = s.identity().serial;
-  j["name"] = s.name;
+  j["name"] = s.displayName();  // the configured name (topology, ENI), else the SII's
+  j["siiName"] = s.name;
   j["escType"] = s.escType;
   j["fmmus"] = s.fmmuCount;
   j["syncManagers"] = s.syncManagerCount;
@@ -88,7 +104,10 @@ int runSlaves(const GlobalOptions& g, bool verbose) {
   for (const auto& s : slaves) {
     fmt::print("{:3}  {}  {:<12} vendor {} product {} rev {}  {}\n", s.position, hex(s.station, 4),
                master::describeAlStatus(s.alStatus), hex(s.identity().vendorId, 8),
-               hex(s.identity().productCode, 8), hex(s.identity().revision, 8), s.name);
+               hex(s.identity().productCode, 8), hex(s.identity().revision, 8),
+               s.configuredName.empty() || s.configuredName == s.name
+                   ? s.displayName()
+                   : s.configuredName + " (" + s.name + ")");
     if (!verbose) continue;
     fmt::print("       ESC type {} rev {} build {}, {} FMMUs, {} SMs, {} KB RAM{}\n",
                hex(s.escType, 2), s.escRevision, s.escBuild, s.fmmuCount, s.syncManagerCount,
@@ -138,6 +157,7 @@ int runStates(const GlobalOptions& g, const std::string& target) {
     for (const auto& s : m.slaves()) {
       list.push_back({{"position", s.position},
                       {"station", s.station},
+                      {"name", s.displayName()},
                       {"state", master::describeAlStatus(s.alStatus)},
                       {"alStatusCode", s.alStatusCode},
                       {"alStatusText", std::string(alStatusCodeText(s.alStatusCode))}});
@@ -149,7 +169,7 @@ int runStates(const GlobalOptions& g, const std::string& target) {
   } else {
     for (const auto& s : m.slaves()) {
       fmt::print("{:3}  {}  {:<12} {}{}\n", s.position, hex(s.station, 4),
-                 master::describeAlStatus(s.alStatus), s.name,
+                 master::describeAlStatus(s.alStatus), s.displayName(),
                  s.alStatusCode != 0
                      ? "  AL status code " + master::describeAlStatusCode(s.alStatusCode)
                      : "");

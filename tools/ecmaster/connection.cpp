@@ -5,6 +5,7 @@
 #include "config/topology_file.hpp"
 #include "link/raw_socket_link.hpp"
 #include "slavesim/generic_slave.hpp"
+#include "topology/slave_names.hpp"
 
 namespace ecsim::tools::ecmaster {
 
@@ -50,6 +51,11 @@ Result<std::unique_ptr<Connection>> Connection::open(const ConnectOptions& optio
                                                  [self](SimTime) { return self->serveOne(); });
   c->master_ = std::make_unique<master::Master>(c->memory_->first, *c->bus_, masterOptions);
   return c;
+}
+
+std::vector<std::string> Connection::simulatedNames() const {
+  if (!network_.segment) return {};
+  return topology::slaveNamesInBusOrder(*network_.segment);
 }
 
 std::optional<SimTime> Connection::serveOne() {

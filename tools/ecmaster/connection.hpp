@@ -31,6 +31,8 @@ class Connection {
   master::Master& master() { return *master_; }
   master::Bus& bus() { return *bus_; }
   bool simulated() const { return server_ != nullptr; }
+  // --sim: the simulated slaves' names in bus order (the topology's); empty otherwise.
+  std::vector<std::string> simulatedNames() const;
   const std::string& description() const { return description_; }
 
  private:

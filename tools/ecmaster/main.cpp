@@ -25,6 +25,12 @@ int main(int argc, char** argv) {
                  "Talk to an in-process simulated line of N generic slaves");
   app.add_option("--config", global.config,
                  "Expected slaves (ENI EtherCATConfig or EcsimMaster XML): identity check");
+  app.add_flag("--check-serial", global.checkSerial,
+               "With --config: the serial numbers must match too (off: vendor, product and the "
+               "configured revision are checked, as IgH and TwinCAT do)");
+  app.add_option("--names", global.names,
+                 "Name the slaves by bus position after this topology or ENI file "
+                 "(Drive1.Statusword); --sim TOPOLOGY names them by itself");
   app.add_option("--timeout-ms", global.timeoutMs, "Frame timeout in ms (default 2)")
       ->check(CLI::Range(1u, 10000u));
   app.add_flag("--json", global.json, "Machine-readable output");
