@@ -304,8 +304,8 @@ inline constexpr std::uint16_t kDcLatch = 0x0001;   // latch status 0x09AE/0x09A
 inline constexpr std::uint16_t kDlStatus = 0x0004;  // DL status changed; ECAT read of 0x0110 clears
 inline constexpr std::uint16_t kAlStatus = 0x0008;  // AL status changed; ECAT read of 0x0130 clears
 inline constexpr unsigned kSmShift = 4;             // bit 4 + n: SyncManager n event
-inline constexpr unsigned kMaxSmEvents = 12;        // bits 4-15
-inline constexpr std::uint16_t kSmBits = 0xFFF0;
+inline constexpr unsigned kMaxSmEvents = 8;         // bits 4-11 (SM0-7); 12-15 reserved
+inline constexpr std::uint16_t kSmBits = 0x0FF0;
 // Reset value: DL status event pending (the ports' link state is new after reset; seen in
 // soem-sdinfo-ek1100-el1004.pcapng, where IRQ 0x0004 is set from the first frame after the
 // mask write, frame 15, until the master reads 0x0110 of the last slave, frame 201).
@@ -314,7 +314,30 @@ inline constexpr std::uint16_t kResetValue = kDlStatus;
 
 namespace al_event {  // 0x0220 AL event request (section II)
 inline constexpr std::uint32_t kAlControl = 0x00000001;  // AL control written; PDI read clears
+inline constexpr std::uint32_t kDcLatch = 0x00000002;    // a PDI-owned latch unit has an event
 }  // namespace al_event
+
+namespace latch {  // DC latch unit (section II 0x0980, 0x09A8-0x09CF)
+// 0x0980 cyclic unit control: latch unit 0 (bit 4) / 1 (bit 5) controlled by the PDI (1) or
+// ECAT (0); the owner writes the control register and its read of a time clears the event.
+inline constexpr std::uint8_t kPdiControlledUnit0 = 0x10;
+// 0x09A8/0x09A9 latch control: 1 = single event (only the first edge until read), 0 =
+// continuous (every edge, no event).
+inline constexpr std::uint8_t kControlSinglePositive = 0x01;
+inline constexpr std::uint8_t kControlSingleNegative = 0x02;
+inline constexpr std::uint8_t kControlMask = 0x03;
+// 0x09AE/0x09AF latch status: edge events (single-event mode only) and the pin's level.
+inline constexpr std::uint8_t kStatusPositiveEvent = 0x01;
+inline constexpr std::uint8_t kStatusNegativeEvent = 0x02;
+inline constexpr std::uint8_t kStatusEvents = 0x03;
+inline constexpr std::uint8_t kStatusPin = 0x04;
+// Time registers: unit u, edge e (0 positive, 1 negative) at 0x09B0 + 16u + 8e.
+constexpr std::uint16_t timeRegister(unsigned unit, bool negativeEdge) {
+  return static_cast<std::uint16_t>(kLatch0TimePositiveEdge.address + 16 * unit +
+                                    (negativeEdge ? 8 : 0));
+}
+inline constexpr unsigned kUnits = 2;
+}  // namespace latch
 
 namespace al {  // 0x0120 / 0x0130
 inline constexpr std::uint16_t kStateMask = 0x000F;

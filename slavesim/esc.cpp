@@ -53,6 +53,7 @@ void Esc::reset() {
     ports = static_cast<std::uint8_t>(ports | (3u << (2 * p)));
   memory_[reg::kPortDescriptor.address] = ports;
   writeLe16(memory_, reg::kEscFeatures.address, type_.features);
+  latchReset();       // DC latch unit (esc_latch.cpp), before the event state follows it
   resetEventState();  // AL control mailbox, ECAT event state (esc_events.cpp)
   miiReset();  // esc_mii.cpp
   loadFromSii();

@@ -119,9 +119,13 @@ class Esc {
 
   // Process data: the newest complete buffer of an ECAT-write SM, and write a complete buffer
   // into an ECAT-read SM. Returns an empty span / false when the SM is not a buffered SM.
+  // pdiOutputs() only looks (tests, inspection); the firmware reads with pdiReadOutputs(),
+  // which is a PDI read of the whole buffer: for a 3-buffer SM it clears "interrupt write" and
+  // sets "interrupt read" in the SM status 0x0805+8n, the SM's ECAT event (section II 0x0805).
   ConstBytes pdiOutputs(unsigned sm) const;
+  ConstBytes pdiReadOutputs(unsigned sm);
   // 1-buffer (mailbox-mode) process-data output SM: the firmware has taken the buffer, so the
-  // master may write the next one.
+  // master may write the next one (a completed PDI read: "interrupt read", as for a mailbox).
   void pdiReleaseBuffer(unsigned sm);
   // True once the master completed at least one buffer of this output SM since it was enabled.
   bool pdiOutputsReceived(unsigned sm) const { return sm < sm_.size() && sm_[sm].hasLatest; }
@@ -248,6 +252,20 @@ class Esc {
   // Recomputes 0x0210 (SyncManager and latch bits follow their status registers) and ecatIrq.
   void refreshEcatEvents();
 
+  // ---- DC latch unit (esc_latch.cpp; section I "Distributed Clocks: LatchSignals", section II
+  // 0x0980, 0x09A8-0x09CF) ------------------------------------------------------------------
+  // The LATCH0/LATCH1 input pin (`unit` 0/1) goes to `level` at simulation time `time` (not
+  // before the last time the ESC saw). An edge stores the system time at `time` in the unit's
+  // positive- or negative-edge time register: in continuous mode every edge, in single-event
+  // mode (0x09A8+unit bit 0/1) only the first one until that register is read by the unit's
+  // owner (0x0980 bit 4+unit: 0 ECAT, 1 PDI), with the event in the latch status and 0x0210
+  // bit 0 (ECAT) or 0x0220 bit 1 (PDI). Nothing happens without a full DC unit.
+  void setLatchInput(unsigned unit, bool level, SimTime time);
+  bool latchInput(unsigned unit) const { return unit < latchPin_.size() && latchPin_[unit]; }
+  // PDI read of a latch time register (the firmware's timestamp): clears the single event when
+  // the PDI owns the unit, as an ECAT read does when the master owns it.
+  std::uint64_t pdiReadLatchTime(unsigned unit, bool negativeEdge);
+
   const EscCounters& counters() const { return counters_; }
 
  private:
@@ -320,6 +338,10 @@ class Esc {
     } else if (address == reg::kCyclicUnitControl.address ||
                address == reg::kDcActivation.address) {
       onSyncActivationWrite();
+      latchEventsChanged();  // 0x0980 says who owns the latch units
+    } else if (address == reg::kLatch0Control.address ||
+               address == reg::kLatch1Control.address) {
+      latchControlWritten();
     }
   }
   // Logical addressing through FMMUs. Returns {readHit, writeHit}.
@@ -450,6 +472,14 @@ class Esc {
     if (smEventMask_ != 0) refreshEcatEvents();  // SM events follow SM status between frames
     if (ecatIrq_ != 0) d.setIrq(static_cast<std::uint16_t>(d.irq() | ecatIrq_));
   }
+  // The PDI completed a read of a write-direction mailbox-mode buffer / a write of a
+  // read-direction one: status 0x0805+8n as section II says (esc_sm.cpp).
+  void pdiReadCompleted(unsigned sm);
+  void pdiWriteCompleted(unsigned sm);
+  // After a PDI-side change of an SM status: the SM's ECAT event follows it.
+  void pdiSmStatusChanged() {
+    if (smEventMask_ != 0) refreshEcatEvents();
+  }
   bool alControlUnread_{false};   // written by ECAT, not yet read by the PDI
   std::uint16_t ecatIrq_{0};      // 0x0210 & 0x0200
   std::uint16_t smEventMask_{0};  // SM bits of 0x0200 (nonzero: SM events are followed)
@@ -472,6 +502,22 @@ class Esc {
   };
   void smTriggerOnlyWrite(std::uint32_t address, std::uint32_t size);
   std::array<SmTriggerOnly, reg::kMaxSyncManagers> smTriggerOnly_{};
+
+  // ---- DC latch unit (esc_latch.cpp) ----
+  // Reset: no events, the status shows the pins' levels (the pins are outside the ESC).
+  void latchReset();
+  // An ECAT read of [begin, end) in 0x09B0-0x09CF: the owner's read clears the single event.
+  void latchTimesRead(std::uint32_t begin, std::uint32_t end);
+  // A latch status or 0x0980 changed: 0x0210 bit 0 and 0x0220 bit 1 follow.
+  void latchEventsChanged();
+  // 0x09A8/0x09A9 written by their owner: edges now in continuous mode show no event.
+  void latchControlWritten();
+  bool latchOwnedByPdi(unsigned unit) const {
+    return (memory_[reg::kCyclicUnitControl.address] & (reg::latch::kPdiControlledUnit0 << unit)) !=
+           0;
+  }
+  std::array<bool, reg::latch::kUnits> latchPin_{};
+  bool latchEcatEvent_{false};  // an ECAT-owned unit shows an event: 0x0210 bit 0
 };
 
 }  // namespace ecsim::slavesim

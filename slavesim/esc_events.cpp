@@ -59,10 +59,9 @@ void Esc::refreshEcatEvents() {
   namespace ev = reg::ecat_event;
   auto request = static_cast<std::uint16_t>(read(reg::kEcatEventRequest) &
                                             (ev::kDlStatus | ev::kAlStatus));
-  // DC latch event: pending while a latch unit's status shows an edge event (bits 0-1).
-  if (((read(reg::kLatch0Status) | read(reg::kLatch1Status)) & 0x03) != 0) {
-    request |= ev::kDcLatch;
-  }
+  // DC latch event: pending while an ECAT-owned latch unit's status shows an edge event
+  // (esc_latch.cpp keeps the flag as the status changes).
+  if (latchEcatEvent_) request |= ev::kDcLatch;
   // SyncManager n event (section I §8, SM control bit 4 "interrupt in ECAT event request"):
   // pending while the buffer has something for the master (read direction: mailbox full or a
   // new buffer written by the PDI) or the PDI has taken what the master wrote (write

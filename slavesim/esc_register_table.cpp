@@ -133,7 +133,7 @@ std::vector<RegisterRow> buildRows() {
       row(kSystemTimeDifferenceFilterDepth, kAll, kAll, 0x04),
       row(kSpeedCounterFilterDepth, kAll, kAll, 0x0C),
       row(kReceiveTimeLatchMode, kAll, kNone),
-      row(kCyclicUnitControl, kAll, kNone, 0, WriteHook::kNone, ByteRule::kStore,
+      row(kCyclicUnitControl, kAll, kNone, 0, WriteHook::kCyclicUnitControl, ByteRule::kStore,
           ReadHook::kSyncUnit),
       row(kDcActivation, kAll, kAll, 0, WriteHook::kDcActivation, ByteRule::kStore,
           ReadHook::kSyncUnit),
@@ -145,9 +145,13 @@ std::vector<RegisterRow> buildRows() {
           ReadHook::kSyncUnit),
       block(kSync0CycleTime.address, 8, kAll, kAll, "SYNC0/SYNC1 Cycle Time", WriteHook::kNone,
             ByteRule::kStore, ReadHook::kSyncUnit),
-      block(kLatch0Control.address, 2, kAll, kNone, "Latch Control"),
+      // DC latch unit (esc_latch.cpp): control written by the unit's owner (0x0980 bits 4/5;
+      // bits 2-7 reserved), status and times the ESC's; the owner's read of a time clears.
+      block(kLatch0Control.address, 2, latch::kControlMask, latch::kControlMask, "Latch Control",
+            WriteHook::kLatchControl, ByteRule::kLatchOwned),
       block(kLatch0Status.address, 2, kNone, kNone, "Latch Status"),
-      block(kLatch0TimePositiveEdge.address, 32, kNone, kNone, "Latch Times"),
+      block(kLatch0TimePositiveEdge.address, 32, kNone, kNone, "Latch Times", WriteHook::kNone,
+            ByteRule::kStore, ReadHook::kLatchTime),
       block(kEcatBufferChangeEventTime.address, 16, kNone, kNone, "Buffer Change Event Times"),
       // ESC specific
       row(kDigitalIoOutputData, kAll, kNone),

@@ -31,6 +31,7 @@ enum class ByteRule : std::uint8_t {
                       // the last value (section II 0x0120 note; Esc::ecatAlControlWritable)
   kSiiLocked,      // 0x0502-0x050F: not while the EEPROM interface is busy (esc_sii.cpp)
   kMiiLocked,      // 0x0510-0x0515: not while MII management is busy or the PDI's (esc_mii.cpp)
+  kLatchOwned,     // 0x09A8/0x09A9: read-only for ECAT while 0x0980 gives the unit to the PDI
 };
 
 // Side effects of an ECAT write, run once per access after all bytes are stored, in this order.
@@ -45,7 +46,9 @@ enum class WriteHook : std::uint8_t {
   kMiiCommand,         // 0x0511: start an MII management command (section II 0x0510)
   kSystemTime,         // 0x0910-0x0917: one step of the drift control loop, 0x092C
   kSpeedCounterStart,  // 0x0930: reset of the drift control loop
+  kCyclicUnitControl,  // 0x0980: latch units' owner (esc_latch.cpp)
   kDcActivation,       // 0x0981: cyclic unit activation
+  kLatchControl,       // 0x09A8/0x09A9: single or continuous latch mode (esc_latch.cpp)
   kFmmu,               // 0x0600-0x06FF: rebuild the active FMMU cache
   kSm,                 // 0x0800-0x087F: SM activation, repeat request, SM cache
   kCount
@@ -62,6 +65,7 @@ enum class ReadHook : std::uint8_t {
   kAlStatusEvent,  // 0x0130: clears 0x0210 bit 3
   kSii,         // 0x0502-0x050F: a command whose busy time is over completes (esc_sii.cpp)
   kMii,         // 0x0510-0x0515: likewise for MII management (esc_mii.cpp)
+  kLatchTime,   // 0x09B0-0x09CF: the owner's read clears the latch event (esc_latch.cpp)
   kCount
 };
 

@@ -79,11 +79,18 @@ bool Esc::writeRegisters(std::uint16_t address, ConstBytes data) {
     // AL control still unread by the firmware: refused, no working counter for it (as a full
     // SyncManager mailbox; section II 0x0120 note does not say).
     if (regs_.rule[a] == ByteRule::kAlControlMailbox && !ecatAlControlWritable()) continue;
+    // A latch unit the PDI owns: its control register is read-only for the master (section
+    // II 0x09A8: write access for ECAT only with 0x0980 bit 4/5 = 0), so no working counter.
+    if (regs_.rule[a] == ByteRule::kLatchOwned &&
+        latchOwnedByPdi(a - reg::kLatch0Control.address)) {
+      continue;
+    }
     accepted = true;
     hooks |= 1u << static_cast<unsigned>(regs_.write[a]);
     switch (regs_.rule[a]) {
       case ByteRule::kStore:
       case ByteRule::kAlControlMailbox:
+      case ByteRule::kLatchOwned:
         memory_[a] = static_cast<std::uint8_t>((memory_[a] & ~mask) | (data[i] & mask));
         break;
       case ByteRule::kClearOnWrite:
@@ -157,8 +164,14 @@ void Esc::runWriteHook(WriteHook hook, std::uint32_t begin, std::uint32_t end, C
     case WriteHook::kSpeedCounterStart:
       dc_.resetControl();
       break;
+    case WriteHook::kCyclicUnitControl:
+      latchEventsChanged();  // esc_latch.cpp
+      break;
     case WriteHook::kDcActivation:
       onSyncActivationWrite();
+      break;
+    case WriteHook::kLatchControl:
+      latchControlWritten();  // esc_latch.cpp
       break;
     case WriteHook::kFmmu:
       rebuildFmmuCache();
@@ -214,6 +227,9 @@ void Esc::afterRegisterRead(std::uint32_t begin, std::uint32_t end) {
     clear |= reg::ecat_event::kAlStatus;
   }
   if (clear != 0) clearEcatEvents(clear);  // esc_events.cpp
+  if ((hooks & (1u << static_cast<unsigned>(ReadHook::kLatchTime))) != 0) {
+    latchTimesRead(begin, end);  // esc_latch.cpp
+  }
 }
 
 bool Esc::pdiWriteRegisters(std::uint16_t address, ConstBytes data) {

@@ -130,10 +130,15 @@ bool Esc::readRam(std::uint16_t address, Bytes out, bool orInto, int smIndex) {
     const SmAccess access = smAccess(s, address, out.size());
     if (access == SmAccess::kDenied) return false;
     copyOut(&memory_[address]);
+    if (invalidFrame_) return true;
+    // Section II 0x0805, as for the 3-buffer below: the first byte read clears "interrupt
+    // write", reading the end address empties the mailbox and sets "interrupt read".
+    std::uint8_t& status = memory_[base + reg::sm::kStatus.address];
+    if (address == cfg.start) status &= static_cast<std::uint8_t>(~reg::sm::kStatusInterruptWrite);
     if (access == SmAccess::kEnd) {  // reading the last byte empties the mailbox
       st.mailboxFull = false;
-      memory_[base + reg::sm::kStatus.address] &=
-          static_cast<std::uint8_t>(~reg::sm::kStatusMailboxFull);
+      status = static_cast<std::uint8_t>((status & ~reg::sm::kStatusMailboxFull) |
+                                         reg::sm::kStatusInterruptRead);
       events_.mailboxRead = true;
     }
     return true;
@@ -178,10 +183,14 @@ bool Esc::writeRam(std::uint16_t address, ConstBytes data, int smIndex) {
     if (access == SmAccess::kDenied) return false;
     std::copy(data.begin(), data.end(), memory_.begin() + address);
     if (cfg.control.watchdogTrigger) triggerPdWatchdog();
+    // Section II 0x0805: the writer's first byte clears "interrupt read" (the PDI's read of the
+    // last mailbox, the master's SM event); a complete buffer sets "interrupt write".
+    std::uint8_t& status = memory_[base + reg::sm::kStatus.address];
+    if (address == cfg.start) status &= static_cast<std::uint8_t>(~reg::sm::kStatusInterruptRead);
     if (access == SmAccess::kEnd) {
       st.mailboxFull = true;
       st.hasLatest = true;  // for 1-buffer process data: outputs received
-      memory_[base + reg::sm::kStatus.address] |= reg::sm::kStatusMailboxFull;
+      status |= reg::sm::kStatusMailboxFull | reg::sm::kStatusInterruptWrite;
       ++counters_.mailboxWrites;
       events_.mailboxReceived = true;
     }
@@ -191,6 +200,10 @@ bool Esc::writeRam(std::uint16_t address, ConstBytes data, int smIndex) {
   const SmAccess access = smAccess(s, address, data.size());
   if (access == SmAccess::kDenied) return false;
   if (cfg.control.watchdogTrigger) triggerPdWatchdog();
+  if (address == cfg.start) {  // the master's first byte clears "interrupt read" (0x0805)
+    memory_[base + reg::sm::kStatus.address] &=
+        static_cast<std::uint8_t>(~reg::sm::kStatusInterruptRead);
+  }
   const std::size_t offset = static_cast<std::size_t>(address - cfg.start);
   const std::size_t bufBase = 3u * static_cast<std::size_t>(cfg.start);
   std::copy(
@@ -253,10 +266,21 @@ std::size_t Esc::pdiMailboxReceive(Bytes out) {
   auto c = smConfig(static_cast<unsigned>(s));
   std::size_t n = std::min<std::size_t>(out.size(), c.length);
   std::copy_n(memory_.begin() + c.start, n, out.begin());
-  sm_[static_cast<unsigned>(s)].mailboxFull = false;
-  memory_[reg::smChannel(static_cast<unsigned>(s)) + reg::sm::kStatus.address] &=
-      static_cast<std::uint8_t>(~reg::sm::kStatusMailboxFull);
+  pdiReadCompleted(static_cast<unsigned>(s));
   return n;
+}
+
+void Esc::pdiReadCompleted(unsigned s) {
+  // The firmware read the whole buffer of a write-direction mailbox-mode SM (section II
+  // 0x0805): its first byte cleared "interrupt write", the end address empties the mailbox and
+  // sets "interrupt read", the SM's ECAT event. A real EL3004's SM0 reads 0x02 after its
+  // firmware took a request (../shared/pcap/replay-ek1914-el3004-mailbox.pcapng frames 970, 984).
+  sm_[s].mailboxFull = false;
+  std::uint8_t& status = memory_[reg::smChannel(s) + reg::sm::kStatus.address];
+  status = static_cast<std::uint8_t>(
+      (status & ~(reg::sm::kStatusMailboxFull | reg::sm::kStatusInterruptWrite)) |
+      reg::sm::kStatusInterruptRead);
+  pdiSmStatusChanged();
 }
 
 bool Esc::pdiMailboxSend(ConstBytes data) {
@@ -271,9 +295,20 @@ bool Esc::pdiMailboxSend(ConstBytes data) {
   std::copy_n(memory_.begin() + c.start, c.length, lastMailboxResponse_.begin());
   lastMailboxResponseSize_ = c.length;
   st.mailboxFull = true;
-  memory_[reg::smChannel(static_cast<unsigned>(s)) + reg::sm::kStatus.address] |=
-      reg::sm::kStatusMailboxFull;
+  pdiWriteCompleted(static_cast<unsigned>(s));
   return true;
+}
+
+void Esc::pdiWriteCompleted(unsigned s) {
+  // The firmware wrote a whole read-direction mailbox (section II 0x0805): its first byte
+  // cleared "interrupt read", the end sets "interrupt write" with "mailbox full". A real
+  // EL3004's SM1 reads 0x09 while a response waits (replay-ek1914-el3004-mailbox.pcapng
+  // frames 964, 978, 992).
+  std::uint8_t& status = memory_[reg::smChannel(s) + reg::sm::kStatus.address];
+  status = static_cast<std::uint8_t>((status & ~reg::sm::kStatusInterruptRead) |
+                                     reg::sm::kStatusMailboxFull |
+                                     reg::sm::kStatusInterruptWrite);
+  pdiSmStatusChanged();
 }
 
 bool Esc::pdiMailboxResponsePending() const {
@@ -290,7 +325,7 @@ void Esc::pdiMailboxRepeat() {
   if (lastMailboxResponseSize_ > 0 && lastMailboxResponseSize_ <= c.length) {
     std::copy_n(lastMailboxResponse_.begin(), lastMailboxResponseSize_, memory_.begin() + c.start);
     sm_[su].mailboxFull = true;
-    memory_[base + reg::sm::kStatus.address] |= reg::sm::kStatusMailboxFull;
+    pdiWriteCompleted(su);
   }
   // Acknowledge: copy the repeat request bit into the PDI control repeat-ack bit.
   std::uint8_t req = memory_[base + reg::sm::kActivate.address] & reg::sm::kActivateRepeatRequest;
@@ -309,6 +344,20 @@ ConstBytes Esc::pdiOutputs(unsigned s) const {
   return ConstBytes(buffers_.data() + bufBase + sm_[s].latest * c.length, c.length);
 }
 
+ConstBytes Esc::pdiReadOutputs(unsigned s) {
+  const ConstBytes data = pdiOutputs(s);
+  if (data.size() < 2 || isMailbox(smCache_[s].control) || !sm_[s].hasLatest) return data;
+  // A 3-buffer output SM: the PDI reads the newest buffer from its start address to its end
+  // (section II 0x0805: the first byte clears "interrupt write", the end sets "interrupt
+  // read", signalled to the master as the SM's ECAT event; the master's next first byte
+  // clears it). 1-buffer outputs are completed by pdiReleaseBuffer().
+  std::uint8_t& status = memory_[reg::smChannel(s) + reg::sm::kStatus.address];
+  status = static_cast<std::uint8_t>((status & ~reg::sm::kStatusInterruptWrite) |
+                                     reg::sm::kStatusInterruptRead);
+  pdiSmStatusChanged();
+  return data;
+}
+
 bool Esc::pdiWriteInputs(unsigned s, ConstBytes data) {
   if (s >= type_.syncManagers) return false;
   auto c = smConfig(s);
@@ -324,7 +373,7 @@ bool Esc::pdiWriteInputs(unsigned s, ConstBytes data) {
     const std::size_t n1 = std::min<std::size_t>(data.size(), c.length);
     std::copy_n(data.begin(), n1, memory_.begin() + c.start);
     st.mailboxFull = true;
-    memory_[reg::smChannel(s) + reg::sm::kStatus.address] |= reg::sm::kStatusMailboxFull;
+    pdiWriteCompleted(s);
     return true;
   }
   const std::size_t bufBase = 3u * static_cast<std::size_t>(c.start);
@@ -343,6 +392,7 @@ bool Esc::pdiWriteInputs(unsigned s, ConstBytes data) {
   status = static_cast<std::uint8_t>(
       (status & ~(reg::sm::kStatusBufferMask | reg::sm::kStatusInterruptRead)) | (done << 4) |
       reg::sm::kStatusInterruptWrite);
+  pdiSmStatusChanged();
   return true;
 }
 
@@ -350,9 +400,8 @@ void Esc::pdiReleaseBuffer(unsigned s) {
   if (s >= type_.syncManagers) return;
   auto c = smConfig(s);
   if (!c.enabled || c.length < 2 || !isMailbox(c.control) || !isEcatWrite(c.control)) return;
-  sm_[s].mailboxFull = false;
-  memory_[reg::smChannel(s) + reg::sm::kStatus.address] &=
-      static_cast<std::uint8_t>(~reg::sm::kStatusMailboxFull);
+  if (!sm_[s].mailboxFull) return;  // nothing taken: no read
+  pdiReadCompleted(s);
 }
 
 }  // namespace ecsim::slavesim

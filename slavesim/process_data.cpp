@@ -100,12 +100,20 @@ void ProcessDataBinding::fillProfile(SlaveProfile& profile, std::uint32_t unchec
   }
 }
 
-void ProcessDataBinding::readOutputs(const Esc& esc) {
+void ProcessDataBinding::readOutputs(Esc& esc) {
+  // One PDI read of each output SM's buffer (its copies are consecutive), as firmware reads
+  // the whole buffer: the ESC marks it read (SM status "interrupt read", Esc::pdiReadOutputs).
+  std::size_t current = buffers_.size();
+  ConstBytes src;
   for (const Copy& c : copies_) {
     const Buffer& b = buffers_[c.buffer];
-    if (!b.outputs || !esc.pdiOutputsReceived(b.sm) || !inProcessRam(esc, b.sm)) continue;
-    const ConstBytes src = esc.pdiOutputs(b.sm);
-    if (static_cast<std::size_t>(c.bitOffset) + c.bits > 8 * src.size()) continue;
+    if (!b.outputs) continue;
+    if (c.buffer != current) {
+      current = c.buffer;
+      src = esc.pdiOutputsReceived(b.sm) && inProcessRam(esc, b.sm) ? esc.pdiReadOutputs(b.sm)
+                                                                     : ConstBytes{};
+    }
+    if (src.empty() || static_cast<std::size_t>(c.bitOffset) + c.bits > 8 * src.size()) continue;
     coe::copyBits(Bytes(c.value, c.valueSize), 0, src, c.bitOffset, c.bits);
   }
 }

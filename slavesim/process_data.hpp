@@ -55,7 +55,7 @@ class ProcessDataBinding {
 
   // Cyclic path (no allocation). readOutputs copies only SMs the master has written at least
   // once; writeInputs writes every input SM.
-  void readOutputs(const Esc& esc);
+  void readOutputs(Esc& esc);
   void writeInputs(Esc& esc);
 
  private:

@@ -64,6 +64,13 @@ class Slave {
   // Runs the firmware: reacts to ESC events (AL control, mailbox) and steps the device.
   void poll(SimTime now);
 
+  // The ESC's DC latch input `unit` (LATCH0/LATCH1) goes to `level` at simulation time `time`
+  // (a sensor or probe wired to the latch pin; Esc::setLatchInput). Edges must come in time
+  // order and not before the frames the ESC already saw.
+  void setLatchSignal(unsigned unit, bool level, SimTime time) {
+    esc_.setLatchInput(unit, level, time);
+  }
+
   AlStateMachine& stateMachine() { return esm_; }
   // SYNC0/SYNC1 pulses delivered to the device so far.
   std::uint64_t syncPulses() const { return syncPulses_; }

@@ -28,7 +28,7 @@ struct VerbArguments {
   std::string_view verb;
   std::array<std::string_view, kMaxVerbKeys> keys;
 };
-constexpr std::array<VerbArguments, 17> kVerbArguments{{
+constexpr std::array<VerbArguments, 18> kVerbArguments{{
     {"loss", {"cable", "rate"}},
     {"corrupt", {"cable", "count", "port", "slave"}},
     {"delay", {"cable", "durationMs", "ns", "port", "slave"}},
@@ -46,6 +46,7 @@ constexpr std::array<VerbArguments, 17> kVerbArguments{{
     {"drive-fault", {"code", "slave"}},
     {"encoder-fault", {"channel", "kind", "on", "slave"}},
     {"input", {"channel", "signal", "slave"}},
+    {"latch", {"level", "slave", "unit"}},
 }};
 
 const VerbArguments* verbArguments(std::string_view verb) {
@@ -607,6 +608,16 @@ Result<std::string> FaultInjector::apply(const FaultAction& a, SimTime now) {
     const auto code = rule.code;
     return fmt::format("{}: SDO {:#06x} aborted with {:#010x} ({})", slave.name(), objIndex, code,
                        sdoAbortText(static_cast<std::uint32_t>(code)));
+  }
+  if (v == "latch") {
+    ECSIM_ASSIGN_OR_RETURN(auto unit, a.number("unit", 0, 1));
+    ECSIM_ASSIGN_OR_RETURN(auto level, a.number("level", 0, 1));
+    if (slave.esc().dcUnit() != slavesim::Esc::DcUnit::kFull) {
+      return a.error(slave.name() + "'s ESC has no DC latch unit");
+    }
+    // The edge (if the level changes) at the action's time (esc_latch.cpp).
+    slave.setLatchSignal(static_cast<unsigned>(unit), level != 0, now);
+    return fmt::format("{}: LATCH{} = {}", slave.name(), unit, level);
   }
   if (v == "encoder-fault") {
     if (slavesim::devices::encoderTerminalOf(slave) != nullptr) return encoderFault(a, slave);

@@ -22,13 +22,16 @@
 //                                   frozen; on=0 clears it); on a drive: fault 0x7305
 //   input slave=S channel=N signal=TEXT    scripted input (slavesim/devices/signal.hpp); on an
 //                                   encoder terminal the shaft position in turns
+//   latch slave=S unit=0|1 level=0|1      the ESC's DC latch input LATCH0/1 goes to the level
+//                                   now (an edge is time-stamped, slavesim/esc_latch.cpp)
 //
 // Numbers: every argument has a range and a value outside it is refused with the range in the
 // message ("loss: rate=nan is not a number in [0, 1]"); NaN, infinities and integers that do
 // not fit are refused, never truncated. rate in [0, 1]; ns in [0, kMaxDelaySpikeNs] (1 s);
 // durationMs in [0, kMaxFaultDurationMs] (one day); count in [0, kMaxCorruptCount]; codes
 // and indexes within their wire width (al-error/drive-fault code and sdo-abort index 16 bits,
-// sdo-abort code 32 bits, sub 8 bits); port 0..3; on 0..1; channel 1..the device's channels.
+// sdo-abort code 32 bits, sub 8 bits); port 0..3; on 0..1; channel 1..the device's channels;
+// unit and level 0..1.
 // Clearing: a fault's zero removes it. "loss rate=0" ends the loss, "corrupt count=0" drops
 // the corruptions still pending at that cable, "delay ns=0" removes the cable's delay spikes;
 // the others have their opposite verb or on=0 (link-up, power-on, mailbox-ok, sdo-ok,
