@@ -36,6 +36,8 @@ void Esc::reset() {
   activeFmmuCount_ = 0;
   smRangeCount_ = 0;
   smTriggerOnlyCount_ = 0;
+  smCache_ = {};  // all zero: no SM enabled (rebuildSmCache's view of the zeroed registers)
+  smEventControl_ = 0;
   smEndAccessed_ = 0;
   invalidFrame_ = false;
   lastMailboxResponseSize_ = 0;

@@ -442,8 +442,17 @@ class Esc {
     std::uint8_t index;
   };
   std::array<SmRange, reg::kMaxSyncManagers> smRanges_{};
-  // smConfig() of the SMs in smRanges_, as of the last rebuildSmCache().
+  // smConfig() of every SM this ESC has, as of the last rebuildSmCache(): start, length,
+  // control and enabled are current (every write of an SM channel's bytes 0-4, 6 and 7 goes
+  // through the ECAT SM hook or afterPdiWrite, both of which rebuild); status, repeat request
+  // and repeat acknowledge are not (read them from memory_). The datagram path and the PDI
+  // functions read this instead of decoding the channel on every access.
   std::array<SmConfig, reg::kMaxSyncManagers> smCache_{};
+  // Bit s: SM s's control byte asks for ECAT events (0x0804 bit 4; refreshEcatEvents).
+  std::uint16_t smEventControl_{0};
+  // The enabled SM with more than one byte in mailbox mode whose ECAT direction is `ecatWrite`
+  // (the lowest such index), or -1.
+  int mailboxSm(bool ecatWrite) const;
   std::vector<std::uint8_t> scratch_;  // read-write and bit-FMMU staging, one datagram
 
   // ---- AL control, device emulation, ECAT events (esc_events.cpp) ----
