@@ -17,9 +17,9 @@ std::optional<EscType> escTypeByName(std::string_view name) {
 }
 
 Esc::Esc(const EscType& type, std::vector<std::uint8_t> siiImage)
-    : type_(type),
-      memory_(kRamStart + static_cast<std::size_t>(type.ramKb) * 1024, 0),
+    : memory_(kRamStart + static_cast<std::size_t>(type.ramKb) * 1024, 0),
       regs_(escRegisterBytes()),
+      type_(type),
       buffers_(3 * (kRamStart + static_cast<std::size_t>(type.ramKb) * 1024), 0),
       sii_(std::move(siiImage)) {
   lastMailboxResponse_.resize(static_cast<std::size_t>(type.ramKb) * 1024);
@@ -36,6 +36,8 @@ void Esc::reset() {
   activeFmmuCount_ = 0;
   smRangeCount_ = 0;
   smTriggerOnlyCount_ = 0;
+  smCache_ = {};  // all zero: no SM enabled (rebuildSmCache's view of the zeroed registers)
+  smEventControl_ = 0;
   smEndAccessed_ = 0;
   invalidFrame_ = false;
   lastMailboxResponseSize_ = 0;
@@ -164,7 +166,13 @@ bool Esc::readMemory(std::uint32_t address, Bytes out, bool orInto) {
     // put their output SM at 0x0F00): split the access at SM boundaries first.
     auto a16 = static_cast<std::uint16_t>(at);
     std::uint32_t limit = std::min(address + size, memEnd);
-    int smIndex = smLookup(at, limit);
+    const int smIndex = smRangeCount_ == 0 ? -1 : smLookup(at, limit);
+    if (smIndex < 0 && at >= kRamStart && !orInto) {  // plain process RAM (most FMMU reads)
+      std::copy_n(memory_.begin() + at, limit - at, piece.begin());
+      any = true;
+      at = limit;
+      continue;
+    }
     if (smIndex < 0 && at < kRamStart) {
       std::uint32_t n = std::min<std::uint32_t>(limit, kRamStart) - at;
       for (std::uint32_t i = 0; i < n; ++i) {
@@ -197,7 +205,13 @@ bool Esc::writeMemory(std::uint32_t address, ConstBytes data) {
     }
     auto a16 = static_cast<std::uint16_t>(at);
     std::uint32_t limit = std::min(address + size, memEnd);
-    int smIndex = smLookup(at, limit);
+    const int smIndex = smRangeCount_ == 0 ? -1 : smLookup(at, limit);
+    if (smIndex < 0 && at >= kRamStart) {  // plain process RAM (most FMMU writes)
+      std::copy_n(piece.begin(), limit - at, memory_.begin() + at);
+      any = true;
+      at = limit;
+      continue;
+    }
     if (smIndex < 0 && at < kRamStart) {
       std::uint32_t n = std::min<std::uint32_t>(limit, kRamStart) - at;
       // A write only counts when some byte of it is writable (real ESCs give no WKC for a

@@ -26,8 +26,8 @@
 namespace ecsim::slavesim {
 
 struct EscCounters {
+  std::uint64_t framesSeen{0};  // first: Esc keeps it on a cache line every frame touches
   std::uint64_t datagramsAddressed{0};
-  std::uint64_t framesSeen{0};
   std::uint64_t mailboxWrites{0};
   std::uint64_t mailboxWritesRejected{0};
   std::uint64_t outOfRangeAccesses{0};
@@ -269,6 +269,38 @@ class Esc {
   const EscCounters& counters() const { return counters_; }
 
  private:
+  // ---- What every passing frame touches, first and together (docs/timing.md, "Simulator
+  // speed"): a frame passing a thousand ESCs finds them outside the L1 cache, so each ESC costs
+  // the cache lines it touches. Line 0: the local clock and the per-datagram flags; line 1: the
+  // datagram's times, per-frame SM state, cache counts, frame counter; line 2: the memory;
+  // then the FMMU cache. A datagram no FMMU of this ESC maps (most of them, in a long line)
+  // touches lines 0, 1 and 3 only. Keep new per-frame state here, cold state further down.
+  alignas(64) DcClock dc_;
+  std::uint16_t lastWkcIncrement_{0};
+  std::uint16_t ecatIrq_{0};      // 0x0210 & 0x0200
+  std::uint16_t smEventMask_{0};  // SM bits of 0x0200 (nonzero: SM events are followed)
+  // Per-frame state of the SM rules and invalid frames (esc_sm.cpp).
+  bool invalidFrame_{false};
+  bool latchArmed_{false};
+  SimTime now_{0};       // simulation time of the datagram being processed
+  SimTime localNow_{0};  // local time of the datagram being processed
+  std::uint32_t smEndAccessed_{0};  // bit per SM: its end address was accessed in this frame
+  std::uint8_t activeFmmuCount_{0};
+  std::uint8_t smRangeCount_{0};
+  std::uint8_t smTriggerOnlyCount_{0};
+  DcUnit dcUnit_{DcUnit::kFull};
+  EscCounters counters_{};  // framesSeen first: on line 1
+  alignas(64) std::vector<std::uint8_t> memory_;  // registers 0x0000-0x0FFF + process RAM
+  const RegisterBytes& regs_;  // the register table, per byte (shared by all ESCs)
+  struct ActiveFmmu {
+    std::uint64_t logicalStartBit;  // absolute logical bit address
+    std::uint64_t logicalEndBit;    // inclusive
+    std::uint32_t physicalStartBit;
+    std::uint8_t type;
+    bool byteAligned;
+  };
+  alignas(64) std::array<ActiveFmmu, reg::kMaxFmmus> activeFmmus_{};
+
   struct SmState {
     // 3-buffer mode: three buffers of `length` bytes in buffers_. `latest` holds the newest
     // complete one (for the reader), `writing` is the one the writer fills.
@@ -387,14 +419,11 @@ class Esc {
   SyncState sync_{};
 
   const EscType type_;
-  std::vector<std::uint8_t> memory_;   // registers 0x0000-0x0FFF + process RAM
-  const RegisterBytes& regs_;          // the register table, per byte (shared by all ESCs)
   std::vector<std::uint8_t> buffers_;  // 3-buffer storage, 3 * length per buffered SM
   std::vector<std::uint8_t> sii_;
   std::array<SmState, reg::kMaxSyncManagers> sm_{};
   std::vector<std::uint8_t> lastMailboxResponse_;
   std::size_t lastMailboxResponseSize_{0};
-  bool latchArmed_{false};
   // SII EEPROM command in progress (esc_sii.cpp): what runs and when it is done.
   bool siiPending_{false};
   std::uint16_t siiPendingCommand_{0};
@@ -426,19 +455,7 @@ class Esc {
   std::uint8_t miiPendingRegister_{0};
   std::uint16_t miiPendingData_{0};
   SimTime miiDoneAt_{0};
-  DcUnit dcUnit_{DcUnit::kFull};
-  DcClock dc_;
-  SimTime now_{0};       // simulation time of the datagram being processed
-  SimTime localNow_{0};  // local time of the datagram being processed
   EscEvents events_{};
-  EscCounters counters_{};
-  struct ActiveFmmu {
-    std::uint64_t logicalStartBit;  // absolute logical bit address
-    std::uint64_t logicalEndBit;    // inclusive
-    std::uint32_t physicalStartBit;
-    std::uint8_t type;
-    bool byteAligned;
-  };
   void rebuildFmmuCache();
 
   struct SmRange {
@@ -447,18 +464,18 @@ class Esc {
     std::uint8_t index;
   };
   std::array<SmRange, reg::kMaxSyncManagers> smRanges_{};
-  std::uint8_t smRangeCount_{0};
-  // smConfig() of the SMs in smRanges_, as of the last rebuildSmCache().
+  // smConfig() of every SM this ESC has, as of the last rebuildSmCache(): start, length,
+  // control and enabled are current (every write of an SM channel's bytes 0-4, 6 and 7 goes
+  // through the ECAT SM hook or afterPdiWrite, both of which rebuild); status, repeat request
+  // and repeat acknowledge are not (read them from memory_). The datagram path and the PDI
+  // functions read this instead of decoding the channel on every access.
   std::array<SmConfig, reg::kMaxSyncManagers> smCache_{};
-  std::array<ActiveFmmu, reg::kMaxFmmus> activeFmmus_{};
-  std::uint8_t activeFmmuCount_{0};
+  // Bit s: SM s's control byte asks for ECAT events (0x0804 bit 4; refreshEcatEvents).
+  std::uint16_t smEventControl_{0};
+  // The enabled SM with more than one byte in mailbox mode whose ECAT direction is `ecatWrite`
+  // (the lowest such index), or -1.
+  int mailboxSm(bool ecatWrite) const;
   std::vector<std::uint8_t> scratch_;  // read-write and bit-FMMU staging, one datagram
-  std::uint16_t lastWkcIncrement_{0};
-  // Per-frame state of the SM rules and invalid frames (below), next to lastWkcIncrement_ so
-  // a passing frame touches no extra cache line per ESC (sim_bench 1000 slaves: +15% without).
-  bool invalidFrame_{false};
-  std::uint8_t smTriggerOnlyCount_{0};
-  std::uint32_t smEndAccessed_{0};  // bit per SM: its end address was accessed in this frame
 
   // ---- AL control, device emulation, ECAT events (esc_events.cpp) ----
   void resetEventState();
@@ -481,8 +498,6 @@ class Esc {
     if (smEventMask_ != 0) refreshEcatEvents();
   }
   bool alControlUnread_{false};   // written by ECAT, not yet read by the PDI
-  std::uint16_t ecatIrq_{0};      // 0x0210 & 0x0200
-  std::uint16_t smEventMask_{0};  // SM bits of 0x0200 (nonzero: SM events are followed)
 
   // ---- SyncManager access rules and invalid frames (esc_sm.cpp; section I §8, §14.1) ----
   enum class SmAccess : std::uint8_t {

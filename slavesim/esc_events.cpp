@@ -15,6 +15,7 @@
 // header passes (so the datagram that reads 0x0110 still carries the DL status event, and the
 // next one does not: soem-sdinfo-ek1100-el1004.pcapng frames 201 and 203).
 #include <algorithm>
+#include <bit>
 
 #include "slavesim/esc.hpp"
 #include "slavesim/esc_internal.hpp"
@@ -67,13 +68,12 @@ void Esc::refreshEcatEvents() {
   // new buffer written by the PDI) or the PDI has taken what the master wrote (write
   // direction: "interrupt read"), as the SM's status register shows it.
   const unsigned count = std::min<unsigned>(type_.syncManagers, ev::kMaxSmEvents);
-  for (unsigned s = 0; s < count; ++s) {
+  // Only the SMs whose control byte asks for it (smEventControl_, decoded when written).
+  for (unsigned bits = smEventControl_ & ((1u << count) - 1); bits != 0; bits &= bits - 1) {
+    const auto s = static_cast<unsigned>(std::countr_zero(bits));
     const std::uint16_t base = reg::smChannel(s);
-    const SmControl control = SmControl::decode(memory_[base + reg::sm::kControl.address]);
-    if (!control.ecatEvent ||
-        (memory_[base + reg::sm::kActivate.address] & reg::sm::kActivateEnable) == 0) {
-      continue;
-    }
+    const SmControl& control = smCache_[s].control;
+    if ((memory_[base + reg::sm::kActivate.address] & reg::sm::kActivateEnable) == 0) continue;
     const std::uint8_t status = memory_[base + reg::sm::kStatus.address];
     const std::uint8_t pending = control.isEcatWrite() ? reg::sm::kStatusInterruptRead
                                  : control.isMailbox() ? reg::sm::kStatusMailboxFull

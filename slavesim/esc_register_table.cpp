@@ -181,7 +181,8 @@ const RegisterBytes& escRegisterBytes() {
         b.reset[a] = static_cast<std::uint8_t>(i < 8 ? r.reset >> (8 * i) : 0);
         b.rule[a] = r.rule;
         b.write[a] = r.write;
-        b.read[a] = r.read;
+        if (r.read != ReadHook::kNone)
+          b.readHookBits[a] = static_cast<std::uint8_t>(1u << (static_cast<unsigned>(r.read) - 1));
       }
     }
     return b;

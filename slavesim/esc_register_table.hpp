@@ -91,8 +91,11 @@ struct RegisterBytes {
   std::array<std::uint8_t, reg::kRegisterSpaceEnd> reset{};
   std::array<ByteRule, reg::kRegisterSpaceEnd> rule{};
   std::array<WriteHook, reg::kRegisterSpaceEnd> write{};
-  std::array<ReadHook, reg::kRegisterSpaceEnd> read{};
+  // Read hooks as a bit set per byte (bit h - 1 = ReadHook h), so the hooks of a range are the
+  // OR of its bytes, taken 8 at a time (Esc::readHooks; every ECAT register read asks).
+  std::array<std::uint8_t, reg::kRegisterSpaceEnd> readHookBits{};
 };
+static_assert(static_cast<unsigned>(ReadHook::kCount) <= 9, "read hooks must fit readHookBits");
 const RegisterBytes& escRegisterBytes();
 
 }  // namespace ecsim::slavesim

@@ -193,11 +193,19 @@ void Esc::runWriteHook(WriteHook hook, std::uint32_t begin, std::uint32_t end, C
 }
 
 std::uint32_t Esc::readHooks(std::uint32_t begin, std::uint32_t end) const {
-  std::uint32_t hooks = 0;
-  for (std::uint32_t a = begin; a < std::min<std::uint32_t>(end, kRamStart); ++a) {
-    hooks |= 1u << static_cast<unsigned>(regs_.read[a]);
+  end = std::min<std::uint32_t>(end, kRamStart);
+  std::uint64_t bits = 0;
+  std::uint32_t a = begin;
+  for (; a + 8 <= end; a += 8) {
+    std::uint64_t eight = 0;
+    std::memcpy(&eight, regs_.readHookBits.data() + a, 8);
+    bits |= eight;
   }
-  return hooks & ~1u;  // ReadHook::kNone
+  for (; a < end; ++a) bits |= regs_.readHookBits[a];
+  bits |= bits >> 32;
+  bits |= bits >> 16;
+  bits |= bits >> 8;
+  return static_cast<std::uint32_t>(bits & 0xFF) << 1;  // bit n = ReadHook n, as the callers test
 }
 
 void Esc::refreshVolatile(std::uint16_t begin, std::uint16_t end) {

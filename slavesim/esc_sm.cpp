@@ -26,8 +26,11 @@ void Esc::rebuildSmCache() {
   for (std::uint8_t k = 0; k < smRangeCount_; ++k) wasBuffer |= 1u << smRanges_[k].index;
   smRangeCount_ = 0;
   smTriggerOnlyCount_ = 0;
+  smEventControl_ = 0;
   for (unsigned s = 0; s < type_.syncManagers; ++s) {
     const SmConfig c = smConfig(s);
+    smCache_[s] = c;
+    if (c.control.ecatEvent) smEventControl_ = static_cast<std::uint16_t>(smEventControl_ | (1u << s));
     if (!c.enabled || c.length == 0) continue;
     if (c.length == 1) {
       // Section II Table 90: "shall be greater 1, otherwise SyncManager is not activated. If
@@ -37,7 +40,6 @@ void Esc::rebuildSmCache() {
     }
     smRanges_[smRangeCount_++] = {c.start, static_cast<std::uint32_t>(c.start) + c.length,
                                   static_cast<std::uint8_t>(s)};
-    smCache_[s] = c;
     if ((wasBuffer & (1u << s)) == 0 && !isMailbox(c.control)) {
       // Freshly activated 3-buffer SM: status bits 5:4 "last written buffer" = 11, no buffer
       // written yet (section II, SyncManager status register 0x0805+8n).
@@ -243,27 +245,23 @@ void Esc::pdiSetAlStatus(std::uint16_t status, std::uint16_t code) {
   refreshEcatEvents();
 }
 
-namespace {
-int findMailboxSm(const Esc& esc, unsigned count, bool ecatWrite) {
-  for (unsigned s = 0; s < count; ++s) {
-    auto c = esc.smConfig(s);
-    if (c.enabled && c.length > 1 && isMailbox(c.control) && isEcatWrite(c.control) == ecatWrite) {
-      return static_cast<int>(s);
-    }
+int Esc::mailboxSm(bool ecatWrite) const {
+  // The enabled SMs of more than one byte are exactly those of smRanges_, in index order.
+  for (std::uint8_t k = 0; k < smRangeCount_; ++k) {
+    const SmConfig& c = smCache_[smRanges_[k].index];
+    if (isMailbox(c.control) && isEcatWrite(c.control) == ecatWrite) return smRanges_[k].index;
   }
   return -1;
 }
-}  // namespace
 
 bool Esc::pdiMailboxAvailable() const {
-  return findMailboxSm(*this, type_.syncManagers, true) >= 0 &&
-         findMailboxSm(*this, type_.syncManagers, false) >= 0;
+  return mailboxSm(true) >= 0 && mailboxSm(false) >= 0;
 }
 
 std::size_t Esc::pdiMailboxReceive(Bytes out) {
-  int s = findMailboxSm(*this, type_.syncManagers, true);
+  int s = mailboxSm(true);
   if (s < 0 || !sm_[static_cast<unsigned>(s)].mailboxFull) return 0;
-  auto c = smConfig(static_cast<unsigned>(s));
+  const SmConfig& c = smCache_[static_cast<unsigned>(s)];
   std::size_t n = std::min<std::size_t>(out.size(), c.length);
   std::copy_n(memory_.begin() + c.start, n, out.begin());
   pdiReadCompleted(static_cast<unsigned>(s));
@@ -284,11 +282,11 @@ void Esc::pdiReadCompleted(unsigned s) {
 }
 
 bool Esc::pdiMailboxSend(ConstBytes data) {
-  int s = findMailboxSm(*this, type_.syncManagers, false);
+  int s = mailboxSm(false);
   if (s < 0) return false;
   auto& st = sm_[static_cast<unsigned>(s)];
   if (st.mailboxFull) return false;
-  auto c = smConfig(static_cast<unsigned>(s));
+  const SmConfig& c = smCache_[static_cast<unsigned>(s)];
   std::size_t n = std::min<std::size_t>(data.size(), c.length);
   std::copy_n(data.begin(), n, memory_.begin() + c.start);
   std::fill_n(memory_.begin() + c.start + static_cast<std::ptrdiff_t>(n), c.length - n, 0);
@@ -312,16 +310,16 @@ void Esc::pdiWriteCompleted(unsigned s) {
 }
 
 bool Esc::pdiMailboxResponsePending() const {
-  int s = findMailboxSm(*this, type_.syncManagers, false);
+  int s = mailboxSm(false);
   return s >= 0 && sm_[static_cast<unsigned>(s)].mailboxFull;
 }
 
 void Esc::pdiMailboxRepeat() {
-  int s = findMailboxSm(*this, type_.syncManagers, false);
+  int s = mailboxSm(false);
   if (s < 0) return;
   const auto su = static_cast<unsigned>(s);
   const std::uint16_t base = reg::smChannel(su);
-  auto c = smConfig(su);
+  const SmConfig& c = smCache_[su];
   if (lastMailboxResponseSize_ > 0 && lastMailboxResponseSize_ <= c.length) {
     std::copy_n(lastMailboxResponse_.begin(), lastMailboxResponseSize_, memory_.begin() + c.start);
     sm_[su].mailboxFull = true;
@@ -335,7 +333,7 @@ void Esc::pdiMailboxRepeat() {
 
 ConstBytes Esc::pdiOutputs(unsigned s) const {
   if (s >= type_.syncManagers) return {};
-  auto c = smConfig(s);
+  const SmConfig& c = smCache_[s];
   if (!c.enabled || !isEcatWrite(c.control) || c.length == 0) return {};
   // 1-buffer (mailbox-mode) process data, and an SM of length 1 (no buffer at all): the
   // memory itself.
@@ -360,7 +358,7 @@ ConstBytes Esc::pdiReadOutputs(unsigned s) {
 
 bool Esc::pdiWriteInputs(unsigned s, ConstBytes data) {
   if (s >= type_.syncManagers) return false;
-  auto c = smConfig(s);
+  const SmConfig& c = smCache_[s];
   if (!c.enabled || isEcatWrite(c.control) || c.length == 0) return false;
   auto& st = sm_[s];
   if (c.length == 1) {  // no buffer (section II Table 90): the PDI writes the memory itself
@@ -398,7 +396,7 @@ bool Esc::pdiWriteInputs(unsigned s, ConstBytes data) {
 
 void Esc::pdiReleaseBuffer(unsigned s) {
   if (s >= type_.syncManagers) return;
-  auto c = smConfig(s);
+  const SmConfig& c = smCache_[s];
   if (!c.enabled || c.length < 2 || !isMailbox(c.control) || !isEcatWrite(c.control)) return;
   if (!sm_[s].mailboxFull) return;  // nothing taken: no read
   pdiReadCompleted(s);

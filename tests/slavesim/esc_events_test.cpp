@@ -86,6 +86,26 @@ TEST_F(EcatAlEvents, MailboxSmEventWhileAResponseWaits) {
   EXPECT_EQ(one(seg_, Command::kBrd, phys(0, 0x0000), {0}).irq, 0x0000) << "read: empty";
 }
 
+TEST_F(EcatAlEvents, SmEventFollowsTheControlByteWhenTheMasterReconfiguresTheSm) {
+  // The SM event follows SM control bit 4 as last written (the ESC decodes it when the channel
+  // is written, not on every datagram): rewritten without it while disabled, no event.
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0800), smChannelBytes(0x1000, 128, 0x26));
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0808), smChannelBytes(0x1080, 128, 0x22));
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0200), le16(0x0020));
+  const std::vector<std::uint8_t> response(16, 0x5A);
+  ASSERT_TRUE(seg_.slave(0).esc().pdiMailboxSend(response));
+  EXPECT_EQ(one(seg_, Command::kBrd, phys(0, 0x0000), {0}).irq, 0x0000) << "control 0x22: none";
+  one(seg_, Command::kFpwr, phys(0x1001, 0x080E), {0});  // SM1 off (its mailbox is emptied)
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0808), smChannelBytes(0x1080, 128, 0x32));
+  ASSERT_TRUE(seg_.slave(0).esc().pdiMailboxSend(response));
+  EXPECT_EQ(one(seg_, Command::kBrd, phys(0, 0x0000), {0}).irq, 0x0020) << "control 0x32";
+  one(seg_, Command::kFpwr, phys(0x1001, 0x080E), {0});
+  EXPECT_EQ(one(seg_, Command::kBrd, phys(0, 0x0000), {0}).irq, 0x0000) << "disabled";
+  one(seg_, Command::kFpwr, phys(0x1001, 0x0808), smChannelBytes(0x1080, 128, 0x22));
+  ASSERT_TRUE(seg_.slave(0).esc().pdiMailboxSend(response));
+  EXPECT_EQ(one(seg_, Command::kBrd, phys(0, 0x0000), {0}).irq, 0x0000) << "control 0x22 again";
+}
+
 TEST_F(EcatAlEvents, InputBufferSmEventUntilTheMasterReadsTheNewData) {
   // SM3, 3-buffer inputs with "interrupt in ECAT event request" (control 0x30); mask bit 4 + 3.
   // Section II 0x0805: "interrupt write" is set when the writer (here the PDI) completed a

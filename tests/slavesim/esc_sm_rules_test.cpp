@@ -169,6 +169,32 @@ TEST_F(SmRules, FreshlyActivatedThreeBufferSmReportsNoBufferWritten) {
   EXPECT_EQ(smStatus(2) & reg::sm::kStatusBufferMask, reg::sm::kStatusBufferMask);
 }
 
+// Section II SM PDI control 0x0807+8n bit 0 "Deactivate SyncManager": the firmware switches an
+// SM off; its mailbox and buffers are gone for the PDI until it switches it on again. (The ESC
+// keeps each SM's configuration decoded from the last write of its channel: this checks that a
+// PDI write of the channel reaches that cache as an ECAT write does.)
+TEST_F(SmRules, SmDeactivatedByThePdiHasNoMailboxAndNoBuffers) {
+  configure(0, 0x1000, 64, kMailboxWrite);
+  configure(1, 0x1080, 64, kMailboxRead);
+  configure(2, 0x1100, 2, kOutputs3BufferNoWd);
+  one(seg_, Command::kFpwr, phys(0x1001, 0x1100), {7, 8});
+  ASSERT_TRUE(esc().pdiMailboxAvailable());
+  ASSERT_EQ(outputs(2), (std::vector<std::uint8_t>{7, 8}));
+  const auto pdiControl = [](unsigned sm) {
+    return static_cast<std::uint16_t>(reg::smChannel(sm) + reg::sm::kPdiControl.address);
+  };
+  esc().pdiWrite8(pdiControl(1), reg::sm::kPdiDeactivate);
+  esc().pdiWrite8(pdiControl(2), reg::sm::kPdiDeactivate);
+  EXPECT_FALSE(esc().pdiMailboxAvailable());
+  EXPECT_FALSE(esc().pdiMailboxSend(std::vector<std::uint8_t>(8, 1)));
+  EXPECT_TRUE(outputs(2).empty());
+  esc().pdiWrite8(pdiControl(1), 0);
+  esc().pdiWrite8(pdiControl(2), 0);
+  EXPECT_TRUE(esc().pdiMailboxAvailable());
+  EXPECT_TRUE(esc().pdiMailboxSend(std::vector<std::uint8_t>(8, 1)));
+  EXPECT_EQ(outputs(2), (std::vector<std::uint8_t>{7, 8}));
+}
+
 // Section I §14.1: with a frame error the processing unit discards "SyncManager buffer changes";
 // RAM is written. The corruption happens on the cable into the slave's port 0.
 TEST_F(SmRules, InvalidFrameChangesNoSyncManagerState) {
