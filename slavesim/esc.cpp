@@ -140,7 +140,8 @@ void Esc::processDatagram(DatagramView d, SimTime time) {
       } else if (access.write) {
         inc = writeMemory(ado, d.data()) ? 1 : 0;
       }
-      if (access.read && ado < kRamStart) afterRegisterRead(ado, end);  // clear-on-read
+      // Clear-on-read, a side effect discarded in an invalid frame (section I §14.1).
+      if (access.read && ado < kRamStart && !invalidFrame_) afterRegisterRead(ado, end);
       break;
     }
   }

@@ -61,7 +61,6 @@ void Esc::setLatchInput(unsigned unit, bool level, SimTime time) {
 }
 
 void Esc::latchTimesRead(std::uint32_t begin, std::uint32_t end) {
-  if (invalidFrame_) return;  // read side effects of an invalid frame are discarded (§14.1)
   bool changed = false;
   for (unsigned u = 0; u < reg::latch::kUnits; ++u) {
     if (latchOwnedByPdi(u)) continue;

@@ -72,6 +72,23 @@ TEST_F(InvalidFrame, DcReceiveTimeLatchIsNotArmed) {
   }
 }
 
+TEST_F(InvalidFrame, ReadsDoNotClearEvents) {
+  // The DL status event is pending after reset (soem-sdinfo frames 12-203) and an ECAT read of
+  // 0x0110 clears it: a side effect of a register read, discarded in an invalid frame
+  // (section I §14.1) as the register writes are.
+  for (std::size_t i = 0; i < 3; ++i) {
+    ASSERT_NE(esc(i).read(reg::kEcatEventRequest) & reg::ecat_event::kDlStatus, 0) << i;
+  }
+  EXPECT_FALSE(
+      sendCorrupted(seg_, 1, {{Command::kBrd, phys(0, reg::kDlStatus.address), {0, 0}}}));
+  EXPECT_EQ(esc(0).read(reg::kEcatEventRequest) & reg::ecat_event::kDlStatus, 0)
+      << "slave 0 saw a valid frame";
+  for (std::size_t i : {1u, 2u}) {
+    EXPECT_NE(esc(i).read(reg::kEcatEventRequest) & reg::ecat_event::kDlStatus, 0)
+        << "slave " << i << ": the invalid frame's read cleared the event";
+  }
+}
+
 TEST_F(InvalidFrame, LogicalWritesReachPlainRam) {
   // FMMU: logical 0x100 (2 bytes) -> physical 0x1300 of slave 1 (plain RAM, no SM), type write.
   std::vector<std::uint8_t> fmmu(16, 0);
