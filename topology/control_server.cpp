@@ -169,6 +169,34 @@ void ControlServer::takeLines(Client& c, std::string_view data, const Handler& h
   }
 }
 
+std::filesystem::path controlSocketDir() {
+  return "/run/ecsim";
+}
+
+std::filesystem::path defaultControlSocket(std::string_view interfaceName) {
+  return controlSocketDir() / (std::string(interfaceName) + ".sock");
+}
+
+Result<std::filesystem::path> findControlSocket(const std::filesystem::path& dir) {
+  std::vector<std::filesystem::path> found;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    if (entry.path().extension() == ".sock" && entry.is_socket(ec)) found.push_back(entry.path());
+  }
+  std::sort(found.begin(), found.end());
+  if (found.size() == 1) return found.front();
+  if (found.empty()) {
+    return makeError(ErrorCode::kNotFound,
+                     "no control socket in " + dir.string() +
+                         ": is `ecsim serve` running? (else give --socket PATH or --iface IF)");
+  }
+  std::string names;
+  for (const auto& f : found) names += (names.empty() ? "" : ", ") + f.filename().string();
+  return makeError(ErrorCode::kInvalidArgument,
+                   "several control sockets in " + dir.string() + " (" + names +
+                       "): choose one with --iface IF or --socket PATH");
+}
+
 Result<std::string> sendControlLine(const std::filesystem::path& path, std::string_view line,
                                     std::chrono::milliseconds timeout) {
   auto addr = socketAddress(path);

@@ -75,6 +75,14 @@ class ControlServer {
   std::vector<Client> clients_;
 };
 
+// Where `ecsim serve` puts its control socket unless told otherwise, and `ecsim ctl` looks for
+// it: /run/ecsim/<interface>.sock.
+std::filesystem::path controlSocketDir();
+std::filesystem::path defaultControlSocket(std::string_view interfaceName);
+// The socket `ecsim ctl` talks to when given none: the only *.sock in controlSocketDir();
+// none or several is an error naming them (and how to choose).
+Result<std::filesystem::path> findControlSocket(const std::filesystem::path& dir);
+
 // Client side (`ecsim ctl`): connects (giving up after `timeout` when the server does not
 // accept), sends one line, waits up to `timeout` for the reply line.
 Result<std::string> sendControlLine(const std::filesystem::path& path, std::string_view line,

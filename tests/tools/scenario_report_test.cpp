@@ -135,5 +135,16 @@ TEST(ScenarioReport, ShardsSplitTheFilesDisjointlyAndCompletely) {
   }
 }
 
+// `ecsim ctl help` lists every action the server takes with its arguments, without a server.
+TEST(CtlHelp, ListsTheActionsAndTheirArguments) {
+  auto run = runCommand({kEcsim, "ctl", "help"});
+  ASSERT_TRUE(run.ok());
+  EXPECT_EQ(run->exitCode, 0) << run->output;
+  EXPECT_NE(run->output.find("  link-down cable= port= slave="), std::string::npos)
+      << run->output;
+  EXPECT_NE(run->output.find("  al-error "), std::string::npos) << run->output;
+  EXPECT_NE(run->output.find("  pause-master "), std::string::npos) << run->output;
+}
+
 }  // namespace
 }  // namespace ecsim::testing

@@ -10,6 +10,7 @@
 
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <future>
 #include <string>
 #include <thread>
@@ -187,6 +188,30 @@ TEST_F(ControlServerTest, AClientThatSendsNothingIsClosedAfterTheIdleTimeout) {
   EXPECT_EQ(received(busy.get()), "ok link-up cable=master\n");
   EXPECT_FALSE(closedByServer(busy.get()));
   EXPECT_EQ(server->clients(), 1u);
+}
+
+// `ecsim ctl` without --socket or --iface (issue #16 item 7): the only socket of the folder
+// `ecsim serve` puts them in; none or several is an error that names them.
+TEST_F(ControlServerTest, ClientFindsTheOnlySocketAndRefusesToGuessBetweenSeveral) {
+  std::filesystem::create_directories(dir_);
+  auto none = findControlSocket(dir_);
+  ASSERT_FALSE(none.ok());
+  EXPECT_NE(none.error().context.find("no control socket in " + dir_.string()), std::string::npos);
+  auto first = ControlServer::open(dir_ / "ecs0.sock");
+  ASSERT_TRUE(first.ok()) << first.error().message();
+  std::ofstream(dir_ / "notes.txt") << "not a socket";
+  std::ofstream(dir_ / "stale.sock") << "a file, not a socket";
+  auto one = findControlSocket(dir_);
+  ASSERT_TRUE(one.ok()) << one.error().message();
+  EXPECT_EQ(*one, dir_ / "ecs0.sock");
+  auto second = ControlServer::open(dir_ / "ecs1.sock");
+  ASSERT_TRUE(second.ok()) << second.error().message();
+  auto two = findControlSocket(dir_);
+  ASSERT_FALSE(two.ok());
+  EXPECT_NE(two.error().context.find("(ecs0.sock, ecs1.sock): choose one with --iface IF"),
+            std::string::npos)
+      << two.error().context;
+  EXPECT_EQ(defaultControlSocket("ecs0"), std::filesystem::path("/run/ecsim/ecs0.sock"));
 }
 
 }  // namespace

@@ -210,7 +210,7 @@ int runServe(ServeOptions o) {
   // Live injection (docs/scenarios.md): fault actions as text lines on a Unix socket.
   topology::FaultInjector faults(network, 1);
   if (o.control.empty()) {
-    o.control = "/run/ecsim/" + (o.iface.empty() ? o.tap : o.iface) + ".sock";
+    o.control = topology::defaultControlSocket(o.iface.empty() ? o.tap : o.iface).string();
   }
   auto control = topology::ControlServer::open(o.control);
   if (!control.ok()) {
