@@ -40,6 +40,37 @@ Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiDevice& device, std::st
   siiOptions.serial = options.serial;
   siiOptions.deviceNameFirst = options.deviceNameFirst;
   ECSIM_ASSIGN_OR_RETURN(SiiContents sii, makeSiiContents(device, options.vendorId, siiOptions));
+
+  coe::OdBuildOptions odOptions;
+  odOptions.vendorId = options.vendorId;
+  odOptions.serial = options.serial;
+  coe::OdBuildReport report;
+  auto od = std::make_shared<coe::ObjectDictionary>(
+      coe::buildObjectDictionary(device, odOptions, &report));
+  if (options.warnings != nullptr) {
+    for (auto& note : report.notes) options.warnings->push_back(std::move(note));
+  }
+  // A PDO that kept the dictionary's mapping is described so in the SII too: a master reading
+  // the SII PDO categories and one reading CoE build the same process image.
+  for (std::uint16_t index : report.keptMappings) {
+    for (auto* list : {&sii.txPdos, &sii.rxPdos}) {
+      for (SiiPdo& p : *list) {
+        if (p.index != index) continue;
+        p.entries.clear();
+        for (const coe::MappedObject& m : coe::mappedObjects(*od, index)) {
+          SiiPdoEntry e;
+          e.index = m.index;
+          e.subIndex = m.subindex;
+          e.bitLength = m.bitLength;
+          if (const coe::Entry* o = od->findEntry(m.index, m.subindex);
+              o != nullptr && o->dataType <= 0xFF) {
+            e.dataType = static_cast<std::uint8_t>(o->dataType);
+          }
+          p.entries.push_back(e);
+        }
+      }
+    }
+  }
   std::vector<std::uint8_t> image;
   if (device.eeprom && device.eeprom->data.size() >= sii::kHeaderBytes) {
     image = device.eeprom->data;  // the vendor's own image, as the device carries it
@@ -54,15 +85,6 @@ Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiDevice& device, std::st
                                             mbx.sendSize != 0 ? mbx.sendSize : mbx.receiveSize};
   }
 
-  coe::OdBuildOptions odOptions;
-  odOptions.vendorId = options.vendorId;
-  odOptions.serial = options.serial;
-  coe::OdBuildReport report;
-  auto od = std::make_shared<coe::ObjectDictionary>(
-      coe::buildObjectDictionary(device, odOptions, &report));
-  if (options.warnings != nullptr) {
-    for (auto& note : report.notes) options.warnings->push_back(std::move(note));
-  }
   // 0x1018 says what the SII says (they differ when a vendor image carries another identity).
   coe::addIdentityObject(*od, {sii.identity.vendorId, sii.identity.productCode,
                                sii.identity.revision, sii.identity.serial});

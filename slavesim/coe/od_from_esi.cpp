@@ -465,6 +465,7 @@ ObjectDictionary buildObjectDictionary(const EsiDevice& device, const OdBuildOpt
           // be bound is no description of the device: the dictionary's mapping stays.
           note(hex4(pdo.index) + ": the PDO's entries (line " + std::to_string(pdo.line) +
                ") cannot be mapped: " + *conflict + "; the dictionary's default mapping is kept");
+          if (report != nullptr) report->keptMappings.push_back(pdo.index);
           continue;
         }
         addMappedObjects(od, pdo, rx, created);

@@ -45,6 +45,9 @@ struct OdBuildOptions {
 // with the PDO list, ...), one line each.
 struct OdBuildReport {
   std::vector<std::string> notes;
+  // PDOs whose own entries could not be mapped, so the dictionary's default mapping was kept:
+  // the SII PDO categories must say the same (makeSlaveFromEsi).
+  std::vector<std::uint16_t> keptMappings;
 };
 
 ObjectDictionary buildObjectDictionary(const EsiDevice& device, const OdBuildOptions& options,

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "config/esi.hpp"
+#include "protocol/sii.hpp"
 #include "slavesim/coe/standard_objects.hpp"
 #include "slavesim/esi_slave.hpp"
 
@@ -142,6 +143,17 @@ TEST(EsiPdoBinding, PdoEntriesThatCannotBeMappedLeaveTheDictionarysMapping) {
   ASSERT_EQ(mapping.size(), 1u);
   EXPECT_EQ(mapping[0].index, 0x6012);
   EXPECT_EQ(mapping[0].subindex, 1);
+  // The SII PDO category says the same, so a master configuring from the SII builds the same
+  // process image as one reading CoE.
+  auto sii = SiiImage::parse(b.slave->esc().sii());
+  ASSERT_TRUE(sii.ok()) << sii.error().message();
+  const auto& tx = sii->contents().txPdos;
+  auto pdo = std::find_if(tx.begin(), tx.end(), [](const SiiPdo& p) { return p.index == 0x1A41; });
+  ASSERT_NE(pdo, tx.end());
+  ASSERT_EQ(pdo->entries.size(), 1u);
+  EXPECT_EQ(pdo->entries[0].index, 0x6012);
+  EXPECT_EQ(pdo->entries[0].subIndex, 1);
+  EXPECT_EQ(pdo->entries[0].bitLength, 16);
   // Said at build time, with the PDO's line in the file (its <TxPdo> is line 75).
   EXPECT_TRUE(anyContains(b.warnings, {"0x1A41", "line 75", "cannot be mapped", "0x6000:2"}))
       << ::testing::PrintToString(b.warnings);
