@@ -1,5 +1,5 @@
 # cmake -P script behind the package_user_project test (see CMakeLists.txt here).
-foreach(var ECSIM_BINARY_DIR USER_PROJECT_DIR WORK_DIR GENERATOR CXX_COMPILER)
+foreach(var ECSIM_BINARY_DIR SOURCE_DIR USER_PROJECT_DIR WORK_DIR GENERATOR CXX_COMPILER)
   if(NOT DEFINED ${var})
     message(FATAL_ERROR "run_package_test.cmake: ${var} is not set")
   endif()
@@ -8,6 +8,28 @@ endforeach()
 set(prefix ${WORK_DIR}/prefix)
 set(build ${WORK_DIR}/user-build)
 file(REMOVE_RECURSE ${WORK_DIR})
+
+# The installed tree alone: version, installed topologies naming only installed files, and the
+# tools relocated (moved outside the build tree) with the source and build trees hidden.
+function(check_installed_tree prefix)
+  execute_process(COMMAND ${prefix}/bin/ecsim --version OUTPUT_VARIABLE version RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0 OR NOT version MATCHES "^ecsim [0-9]+\\.[0-9]+\\.[0-9]+")
+    message(FATAL_ERROR "ecsim --version (${rc}): ${version}")
+  endif()
+  message(STATUS "ecsim --version: ${version}")
+  file(GLOB_RECURSE topologies ${prefix}/share/ecsim/topologies/*.xml)
+  foreach(t ${topologies})
+    file(READ ${t} text)
+    get_filename_component(dir ${t} DIRECTORY)
+    string(REGEX MATCHALL "(esi|eeprom|topology|eni)=\"[^\"]+\"" refs "${text}")
+    foreach(ref ${refs})
+      string(REGEX REPLACE "^[a-z]+=\"([^\"]+)\"$" "\\1" file "${ref}")
+      if(NOT EXISTS ${dir}/${file})
+        message(FATAL_ERROR "installed ${t} names ${file}, which is not installed")
+      endif()
+    endforeach()
+  endforeach()
+endfunction()
 
 function(run what)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE out)
@@ -48,4 +70,38 @@ if(PKG_CONFIG)
   endif()
   message(STATUS "pkg-config: ${flags}")
 endif()
+
+check_installed_tree(${prefix})
+# Moved out of the build tree (a relocatable install: data found from the executable), then run
+# where neither the source tree nor the build tree can be seen (the build tree first: it may
+# lie inside the source tree).
+string(RANDOM LENGTH 8 tag)
+set(moved /tmp/ecsim-package-${tag})
+set(demo_out /tmp/ecsim-package-${tag}-demo)
+file(COPY ${prefix}/ DESTINATION ${moved})
+file(REMOVE_RECURSE ${prefix})
+execute_process(COMMAND id -u OUTPUT_VARIABLE uid OUTPUT_STRIP_TRAILING_WHITESPACE)
+find_program(UNSHARE unshare)
+if(uid STREQUAL "0" AND UNSHARE)
+  execute_process(
+    COMMAND ${UNSHARE} --mount --propagation private sh -c
+            "mount -t tmpfs ecsim-hidden \"$2\" && mount -t tmpfs ecsim-hidden \"$1\" && exec \"$3/bin/ecsim\" demo --out \"$4\""
+            hide ${SOURCE_DIR} ${ECSIM_BINARY_DIR} ${moved} ${demo_out}
+    RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE out)
+  set(hidden "with the source and build trees hidden")
+elseif("$ENV{CI}" STREQUAL "true")
+  file(REMOVE_RECURSE ${moved})
+  message(FATAL_ERROR "CI=true and hiding the source tree needs root and unshare (uid ${uid})")
+else()
+  execute_process(COMMAND ${moved}/bin/ecsim demo --out ${demo_out}
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE out)
+  set(hidden "(not root: source tree not hidden)")
+endif()
+file(REMOVE_RECURSE ${moved})
+if(NOT rc EQUAL 0 OR NOT EXISTS ${demo_out}/demo.pcap)
+  file(REMOVE_RECURSE ${demo_out})
+  message(FATAL_ERROR "the moved install's ecsim demo ${hidden} failed (${rc}):\n${out}")
+endif()
+file(REMOVE_RECURSE ${demo_out})
+message(STATUS "the moved install's ecsim demo ${hidden}: ok")
 file(REMOVE_RECURSE ${WORK_DIR})

@@ -10,10 +10,12 @@
 #include <CLI/CLI.hpp>
 
 #include "tools/ecmaster/commands.hpp"
+#include "tools/common/install_paths.hpp"
 
 int main(int argc, char** argv) {
   using namespace ecsim::tools::ecmaster;
   CLI::App app{"ecmaster - ecsim's EtherCAT master"};
+  app.set_version_flag("--version", ecsim::tools::versionText("ecmaster"));
   app.require_subcommand(1);
   app.fallthrough();
   GlobalOptions global;

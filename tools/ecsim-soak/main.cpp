@@ -13,10 +13,12 @@
 
 #include "link/raw_socket_link.hpp"
 #include "tools/ecsim-soak/soak.hpp"
+#include "tools/common/install_paths.hpp"
 
 int main(int argc, char** argv) {
   using namespace ecsim::soak;
   CLI::App app{"ecsim-soak - valid and malformed EtherCAT frames, every answer checked"};
+  app.set_version_flag("--version", ecsim::tools::versionText("ecsim-soak"));
   std::string iface;
   std::string netns;
   SoakOptions o;

@@ -33,6 +33,7 @@
 #include "topology/network_builder.hpp"
 #include "topology/network_server.hpp"
 #include "topology/pcap_cable_tap.hpp"
+#include "tools/common/install_paths.hpp"
 
 namespace ecsim::tools {
 namespace {
@@ -128,19 +129,18 @@ plot 'demo.csv' using 1:4 with lines title 'following error'
 unset multiplot
 )";
 
-std::string defaultDemoTopology() {
-  if (const char* dir = std::getenv("ECSIM_DATA_DIR")) {
-    return (std::filesystem::path(dir) / "topologies" / "demo.xml").string();
-  }
-  const std::filesystem::path installed = ECSIM_INSTALLED_DATA_DIR "/topologies/demo.xml";
-  if (std::filesystem::exists(installed)) return installed.string();
-  return ECSIM_SOURCE_DATA_DIR "/topologies/demo.xml";
-}
-
 int runDemo(const DemoOptions& o) {
   std::filesystem::create_directories(o.out);
   const std::string pcapPath = (std::filesystem::path(o.out) / "demo.pcap").string();
-  const std::string topologyPath = o.topology.empty() ? defaultDemoTopology() : o.topology;
+  std::string topologyPath = o.topology;
+  if (topologyPath.empty()) {
+    auto demo = dataFile("topologies/demo.xml");
+    if (!demo.ok()) {
+      fmt::print(stderr, "ecsim demo: {}\n", demo.error().message());
+      return 1;
+    }
+    topologyPath = demo->string();
+  }
   auto config = loadTopologyFile(topologyPath);
   if (!config.ok()) {
     fmt::print(stderr, "ecsim demo: {}\n", config.error().message());

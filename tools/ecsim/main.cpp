@@ -4,9 +4,11 @@
 #include <CLI/CLI.hpp>
 
 #include "tools/ecsim/commands.hpp"
+#include "tools/common/install_paths.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"ecsim - a software EtherCAT network for hardware-in-the-loop testing"};
+  app.set_version_flag("--version", ecsim::tools::versionText("ecsim"));
   app.require_subcommand(1);
   auto serve = ecsim::tools::addServeCommand(app);
   auto demo = ecsim::tools::addDemoCommand(app);

@@ -9,6 +9,7 @@
 #include "tools/ecsim/commands.hpp"
 #include "topology/network_builder.hpp"
 #include "topology/replay.hpp"
+#include "tools/common/install_paths.hpp"
 
 namespace ecsim::tools {
 namespace {
@@ -26,8 +27,15 @@ int runReplay(const ReplayOptions& o) {
     fmt::print(stderr, "ecsim replay: {}\n", records.error().message());
     return 1;
   }
-  std::string topologyPath =
-      o.topology.empty() ? std::string(ECSIM_SOURCE_DATA_DIR "/topologies/demo.xml") : o.topology;
+  std::string topologyPath = o.topology;
+  if (topologyPath.empty()) {
+    auto demo = dataFile("topologies/demo.xml");
+    if (!demo.ok()) {
+      fmt::print(stderr, "ecsim replay: {}\n", demo.error().message());
+      return 1;
+    }
+    topologyPath = demo->string();
+  }
   auto config = loadTopologyFile(topologyPath);
   if (!config.ok()) {
     fmt::print(stderr, "ecsim replay: {}\n", config.error().message());

@@ -28,6 +28,7 @@
 #include "topology/network_from_eni.hpp"
 #include "topology/network_server.hpp"
 #include "topology/pcap_cable_tap.hpp"
+#include "tools/common/install_paths.hpp"
 
 namespace ecsim::tools {
 namespace {
@@ -50,16 +51,6 @@ struct ServeOptions {
   std::string statusJson;  // status rewritten periodically to this file
   std::string control;     // live-injection socket; empty: /run/ecsim/<interface>.sock
 };
-
-// The built-in demo network: the installed copy, else the one in the source tree.
-std::string defaultTopologyPath() {
-  if (const char* dir = std::getenv("ECSIM_DATA_DIR")) {
-    return (std::filesystem::path(dir) / "topologies" / "demo.xml").string();
-  }
-  const std::filesystem::path installed = ECSIM_INSTALLED_DATA_DIR "/topologies/demo.xml";
-  if (std::filesystem::exists(installed)) return installed.string();
-  return ECSIM_SOURCE_DATA_DIR "/topologies/demo.xml";
-}
 
 int runServe(ServeOptions o) {
   if (static_cast<int>(!o.iface.empty()) + static_cast<int>(!o.tap.empty()) +
@@ -103,12 +94,23 @@ int runServe(ServeOptions o) {
   }
 
   topology::Network network;
-  if (o.topology.empty() && o.slaves == 0) o.topology = defaultTopologyPath();
+  if (o.topology.empty() && o.slaves == 0) {
+    auto demo = dataFile("topologies/demo.xml");
+    if (!demo.ok()) {
+      fmt::print(stderr, "ecsim serve: {}\n", demo.error().message());
+      return 1;
+    }
+    o.topology = demo->string();
+  }
   auto root = o.topology.empty() ? Result<std::string>(std::string()) : xmlRootName(o.topology);
   if (root.ok() && *root == "EtherCATConfig") {  // an ENI: devices from the ESI folder
     if (o.esiDir.empty()) {
-      o.esiDir = (std::filesystem::path(defaultTopologyPath()).parent_path().parent_path() / "esi")
-                     .string();
+      auto esi = dataFile("esi");
+      if (!esi.ok()) {
+        fmt::print(stderr, "ecsim serve: {}\n", esi.error().message());
+        return 1;
+      }
+      o.esiDir = esi->string();
     }
     auto built = topology::buildNetworkFromEni(o.topology, {o.esiDir});
     if (!built.ok()) {
