@@ -11,6 +11,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libtinyxml2-dev libpcap-dev libcli11-dev libfmt-dev libspdlog-dev nlohmann-json3-dev
   libeigen3-dev libre2-dev tshark gnuplot-nox iproute2 ethtool procps libxml2-utils
+  file dpkg-dev
 )
 
 install_missing() {
