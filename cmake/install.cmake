@@ -1,16 +1,17 @@
 # Installation and the CMake/pkg-config packages (issue #10). Included at the end of the
 # top-level CMakeLists.txt, after every library exists.
 #
-#   <prefix>/include/ecsim/{protocol,link,config,slavesim,topology,master,embed}/*.hpp
+#   <prefix>/include/ecsim/{protocol,link,config,slavesim,topology,master,embed}/*.hpp: the
+#   public headers only, included as <ecsim/master/master.hpp>
 #   <prefix>/lib/libecsim_*.a
 #   <prefix>/lib/cmake/ecsim/ecsimConfig.cmake (+ version, exported targets)
 #   <prefix>/lib/pkgconfig/ecsim.pc
 #   <prefix>/bin/ecsim, ecmaster, ecsim-soak and <prefix>/share/ecsim/{esi,topologies} (installed by
 #   tools/ecsim, tools/ecmaster, tools/ecsim-soak), <prefix>/share/ecsim/examples/user-project
 #
-# Headers keep the source layout under include/ecsim, and include/ecsim is an include
-# directory of every exported target, so installed code includes "protocol/result.hpp"
-# exactly as the sources do (<ecsim/protocol/result.hpp> works too).
+# Headers keep the source layout under include/ecsim; include/ is the exported targets' include
+# directory, so users write <ecsim/protocol/result.hpp> and their own "config/..." never meets
+# ours. Eigen stays private (slavesim's device models; no public header includes it).
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
@@ -19,12 +20,18 @@ set(ecsim_install_cmakedir ${CMAKE_INSTALL_LIBDIR}/cmake/ecsim)
 
 foreach(lib ${ecsim_install_libraries})
   set_target_properties(ecsim_${lib} PROPERTIES EXPORT_NAME ${lib})
-  target_include_directories(ecsim_${lib} PUBLIC
-    $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/ecsim>)
-  install(DIRECTORY ${PROJECT_SOURCE_DIR}/${lib}/
-          DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/ecsim/${lib}
-          FILES_MATCHING PATTERN "*.hpp")
 endforeach()
+
+# The public headers only (cmake/public_headers.cmake: what the embedding API, the master and
+# the fixture include), under include/ecsim and including each other as <ecsim/...>; the
+# exported targets put include/ (ecsim_library's INSTALL_INTERFACE) on a user's search path.
+set(ecsim_public_include ${PROJECT_BINARY_DIR}/public-include)
+add_custom_target(ecsim_public_headers ALL
+  COMMAND ${CMAKE_COMMAND} -DSOURCE_DIR=${PROJECT_SOURCE_DIR} -DOUTPUT_DIR=${ecsim_public_include}
+          "-DROOTS=embed/simulated_network.hpp,master/master.hpp,embed/testing/network_fixture.hpp"
+          -P ${PROJECT_SOURCE_DIR}/cmake/public_headers.cmake
+  COMMENT "" VERBATIM)
+install(DIRECTORY ${ecsim_public_include}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 
 # The static libraries link ecsim_options privately; their exported link interface names it
 # ($<LINK_ONLY:...>), so it is exported too. Only its link options reach a user's program: the
@@ -52,7 +59,7 @@ endforeach()
 install(TARGETS ${ecsim_install_targets} EXPORT ecsimTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
-        INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/ecsim)
+        INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(EXPORT ecsimTargets NAMESPACE ecsim:: DESTINATION ${ecsim_install_cmakedir})
 
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/ecsimConfig.cmake.in
@@ -81,7 +88,7 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/examples/user-project
 # Everything `cmake --install` copies, so tests/package can bring a build tree up to date
 # before installing it (a no-op after a full build).
 add_custom_target(ecsim_install_deps)
-add_dependencies(ecsim_install_deps ${ecsim_install_targets})
+add_dependencies(ecsim_install_deps ${ecsim_install_targets} ecsim_public_headers)
 foreach(tool ecsim ecmaster ecsim-soak)
   if(TARGET ${tool})
     add_dependencies(ecsim_install_deps ${tool})

@@ -4,8 +4,8 @@
 
 #include <optional>
 
-#include "embed/testing/network_fixture.hpp"
-#include "master/process_image.hpp"
+#include <ecsim/embed/testing/network_fixture.hpp>
+#include <ecsim/master/process_image.hpp>
 
 namespace {
 

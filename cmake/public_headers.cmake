@@ -1,0 +1,52 @@
+# cmake -P script run at every build (cmake/install.cmake, target ecsim_public_headers): the
+# public headers as installed. The public API is what the roots include, transitively: the
+# embedding API (embed/simulated_network.hpp), the master (master/master.hpp) and the
+# GoogleTest fixture (embed/testing/network_fixture.hpp); no other header is installed. In the
+# copies, #include "lib/x.hpp" becomes #include <ecsim/lib/x.hpp>, so a user's program includes
+# <ecsim/...> and only the install's include/ is on its search path (a user's own config/ or
+# link/ folder cannot collide). A file is rewritten only when its content changes; headers no
+# longer public are removed.
+cmake_minimum_required(VERSION 3.25)
+foreach(var SOURCE_DIR OUTPUT_DIR ROOTS)
+  if(NOT DEFINED ${var})
+    message(FATAL_ERROR "public_headers.cmake: ${var} is not set")
+  endif()
+endforeach()
+string(REPLACE "," ";" pending "${ROOTS}")
+set(public "")
+while(pending)
+  list(POP_FRONT pending header)
+  if(header IN_LIST public)
+    continue()
+  endif()
+  if(NOT EXISTS ${SOURCE_DIR}/${header})
+    message(FATAL_ERROR "public_headers.cmake: ${header} (included by a public header) is not in ${SOURCE_DIR}")
+  endif()
+  list(APPEND public ${header})
+  file(STRINGS ${SOURCE_DIR}/${header} includes REGEX "^[ \t]*#[ \t]*include[ \t]+\"[^\"]+\"")
+  foreach(line ${includes})
+    string(REGEX REPLACE "^[ \t]*#[ \t]*include[ \t]+\"([^\"]+)\".*$" "\\1" included "${line}")
+    list(APPEND pending ${included})
+  endforeach()
+endwhile()
+
+set(written "")
+foreach(header ${public})
+  file(READ ${SOURCE_DIR}/${header} text)
+  string(REGEX REPLACE "#([ \t]*)include([ \t]+)\"([^\"]+)\"" "#\\1include\\2<ecsim/\\3>" text "${text}")
+  set(out ${OUTPUT_DIR}/ecsim/${header})
+  set(old "")
+  if(EXISTS ${out})
+    file(READ ${out} old)
+  endif()
+  if(NOT old STREQUAL text)
+    file(WRITE ${out} "${text}")
+  endif()
+  list(APPEND written ${out})
+endforeach()
+file(GLOB_RECURSE existing ${OUTPUT_DIR}/ecsim/*)
+foreach(f ${existing})
+  if(NOT f IN_LIST written)
+    file(REMOVE ${f})
+  endif()
+endforeach()
