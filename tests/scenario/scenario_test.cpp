@@ -7,7 +7,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "scenario/runner.hpp"
+#include "scenario/engine.hpp"
 #include "scenario/scenario.hpp"
 #include "support/fifo.hpp"
 
