@@ -5,7 +5,7 @@
 #include <map>
 
 #include "config/xml_util.hpp"
-#include "scenario/runner.hpp"
+#include "scenario/engine.hpp"
 
 namespace ecsim::scenario {
 namespace {
@@ -82,8 +82,11 @@ std::string Expectation::describe() const {
 }
 
 std::string formatReport(const ScenarioResult& r) {
-  std::string out = fmt::format("scenario {} ({}), seed {}: {} cycles of {} us\n", r.name, r.file,
-                                r.seed, r.cycles, r.cycleTime / kNsPerUs);
+  // The in-process master is the default and not named (its reports stay as they were).
+  const std::string master =
+      r.master.empty() || r.master == "in-process" ? "" : ", master " + r.master;
+  std::string out = fmt::format("scenario {} ({}){}, seed {}: {} cycles of {} us\n", r.name,
+                                r.file, master, r.seed, r.cycles, r.cycleTime / kNsPerUs);
   for (const auto& line : r.log) out += line + "\n";
   if (!r.error.empty()) {
     out += fmt::format("ERROR  {}\n", r.error);

@@ -1,7 +1,8 @@
 // A scenario (docs/scenarios.md): a network, the master that runs it, a timeline of fault
 // actions and the expectations a run is judged by. Read from XML; every error names the file
-// and line. The master is ours in-process (scenario/runner.hpp) or an external command under
-// test (<Master kind="external" command="prog {iface}"/>, scenario/external_runner.hpp).
+// and line. The scenario engine (scenario/engine.hpp) runs it with the master under test its
+// <Master kind> names: ours in-process, ours over veth, or an external command
+// (<Master kind="external" command="prog {iface}"/>).
 //
 //   <Scenario name="cable_break" topology="../examples/topologies/demo.xml" cycleUs="1000"
 //             durationMs="3000" seed="1">
@@ -95,7 +96,7 @@ struct Scenario {
   std::string name;
   std::string description;
   std::filesystem::path topology;
-  std::string masterKind{"in-process"};  // or "external"
+  std::string masterKind{"in-process"};  // or "veth" (ours over veth), "external" (a command)
   std::string masterCommand;             // external
   // External masters (docs/scenarios.md, "External masters"):
   int masterLine{0};                        // of <Master>, for errors about the command
@@ -125,10 +126,11 @@ Result<Scenario> parseScenario(std::string_view xml, const std::filesystem::path
 // Every slave and cable an action or expectation names is in the topology; the error names
 // the scenario's file and line and the closest name the topology has.
 Status checkTopologyNames(const Scenario& scenario, const TopologyConfig& topology);
-// What an external master can be judged on: rejects (naming file and line) the expectations
-// that need the master's internals (Detected, Statistic, Variable, Continuity) and the
-// pause-master action for external masters, and ExitStatus, Output and BackInOp afterMs for the
-// in-process one. parseScenario() calls it.
+// What each master under test can be judged on: rejects (naming file and line) the
+// expectations that need the master's internals (Detected, Statistic, Variable, Continuity)
+// and the pause-master action for external masters, and ExitStatus, Output and BackInOp
+// afterMs for ours (in-process and veth: the rules of a scenario written for our master do not
+// change with how it is run). parseScenario() calls it.
 Status checkMasterKind(const Scenario& scenario);
 
 std::string_view toString(Compare c);

@@ -502,8 +502,8 @@ Result<Scenario> parseScenario(std::string_view xml, const std::filesystem::path
   if (const auto* m = root->FirstChildElement("Master")) {
     ECSIM_TRY(xml::checkNames(r.context(), m, kMasterNames));
     s.masterKind = Reader::attr(m, "kind").value_or("in-process");
-    if (s.masterKind != "in-process" && s.masterKind != "external") {
-      return r.error(m, "Master kind must be in-process or external");
+    if (s.masterKind != "in-process" && s.masterKind != "veth" && s.masterKind != "external") {
+      return r.error(m, "Master kind must be in-process, veth or external");
     }
     s.masterCommand = Reader::attr(m, "command").value_or("");
     s.masterLine = m->GetLineNum();

@@ -11,7 +11,7 @@
 #include <map>
 
 #include "scenario/command_output.hpp"
-#include "scenario/external_runner.hpp"
+#include "scenario/engine.hpp"
 #include "scenario/scenario.hpp"
 
 namespace ecsim::scenario {

@@ -18,7 +18,7 @@
 #include <sstream>
 
 #include "link/netns.hpp"
-#include "scenario/external_runner.hpp"
+#include "scenario/engine.hpp"
 #include "scenario/scenario.hpp"
 #include "support/privileges.hpp"
 #include "support/readiness.hpp"
@@ -87,7 +87,7 @@ TEST_F(ExternalScenario, AFailingCommandGivesAFailingReportNamingTheExpectation)
   // Line 1 declaration, 2 Scenario, 3 Master, 4 Expect, 5 and 6 the expectations.
   auto s = write("<Master kind=\"external\" command=\"false\"/>",
                  "<ExitStatus value=\"0\"/>\n<Output contains=\"slaves found\"/>\n");
-  auto r = runExternalScenario(s);
+  auto r = runScenario(s);
   ASSERT_TRUE(r.error.empty()) << r.error;
   EXPECT_FALSE(r.passed());
   const std::string report = formatReport(r);
@@ -118,7 +118,9 @@ TEST_F(ExternalScenario, TheCommandSeesItsInterfaceAndItsOutputIsJudged) {
     if (name == "ECSIM_TEST_WORD") return std::string("bird");
     return std::nullopt;
   };
-  auto r = runExternalScenario(s, {}, external);
+  RunOptions options;
+  options.external = external;
+  auto r = runScenario(s, options);
   ASSERT_TRUE(r.error.empty()) << r.error;
   EXPECT_TRUE(r.passed()) << formatReport(r);
   EXPECT_NE(readText(dir_ / "t.output.txt").find("done bird"), std::string::npos);
@@ -135,7 +137,7 @@ TEST_F(ExternalScenario, OutputLinesAreJudgedByWhenTheyAppeared) {
       "<Output contains=\"early\" afterMs=\"0\" withinMs=\"250\"/>\n"
       "<Output contains=\"late\" afterMs=\"0\" withinMs=\"250\"/>\n",
       "durationMs=\"5000\"");
-  auto r = runExternalScenario(s);
+  auto r = runScenario(s);
   ASSERT_TRUE(r.error.empty()) << r.error;
   ASSERT_EQ(r.results.size(), 4u);
   EXPECT_TRUE(r.results[0].passed) << r.results[0].observed;
@@ -158,7 +160,7 @@ TEST_F(ExternalScenario, A300KbOutputLineIsJudgedWithoutCrashingTheRunner) {
       "<ExitStatus value=\"0\"/>\n<Output matches=\"(a|b)*c\"/>\n"
       "<Output matches=\"^a+$\" op=\"eq\" value=\"4\"/>\n",
       "durationMs=\"5000\"");
-  auto r = runExternalScenario(s);
+  auto r = runScenario(s);
   ASSERT_TRUE(r.error.empty()) << r.error;
   EXPECT_TRUE(r.passed()) << formatReport(r);
   EXPECT_NE(formatReport(r).find("1 lines longer than 65536 bytes"), std::string::npos)
@@ -174,7 +176,7 @@ TEST_F(ExternalScenario, ACommandStillRunningAtTheEndIsStopped) {
       "command=\"echo started; sleep 300\"/>",
       "<ExitStatus value=\"143\"/>\n<Output contains=\"started\"/>\n");
   const auto before = std::chrono::steady_clock::now();
-  auto r = runExternalScenario(s);
+  auto r = runScenario(s);
   EXPECT_LT(std::chrono::steady_clock::now() - before, std::chrono::seconds(60));
   ASSERT_TRUE(r.error.empty()) << r.error;
   EXPECT_TRUE(r.passed()) << formatReport(r);
@@ -192,7 +194,7 @@ TEST_F(ExternalScenario, ReportsDifferOnlyInMeasuredTimes) {
   const std::regex times(" *-?[0-9]+\\.[0-9]{3} ms");
   std::string first;
   for (int run = 0; run < 2; ++run) {
-    auto r = runExternalScenario(s);
+    auto r = runScenario(s);
     ASSERT_TRUE(r.error.empty()) << r.error;
     const std::string report = std::regex_replace(formatReport(r), times, " T ms");
     if (run == 0) {
@@ -230,7 +232,7 @@ TEST_F(ExternalScenario, SigintStopsTheCommandAndRemovesTheNamespace) {
     sent = true;
   });
   const auto before = std::chrono::steady_clock::now();
-  auto r = runExternalScenario(s);
+  auto r = runScenario(s);
   interrupter.join();
   ASSERT_TRUE(sent) << "the run's namespace never appeared";
   EXPECT_LT(std::chrono::steady_clock::now() - before, std::chrono::seconds(60));
@@ -252,14 +254,16 @@ TEST_F(ExternalScenario, EcmasterRecoversFromACableBreakAndFailsWithoutRecovery)
     if (name == "ECMASTER") return std::string(ECSIM_BINARY_DIR) + "/tools/ecmaster/ecmaster";
     return std::nullopt;
   };
-  auto r = runExternalScenario(*s, RunOptions{}, external);
+  RunOptions options;
+  options.external = external;
+  auto r = runScenario(*s, options);
   std::string report = formatReport(r);
   std::cout << report;
   ASSERT_TRUE(r.error.empty()) << r.error;
   EXPECT_TRUE(r.passed()) << report;
 
   s->masterCommand += " --no-recovery";
-  r = runExternalScenario(*s, RunOptions{}, external);
+  r = runScenario(*s, options);
   report = formatReport(r);
   std::cout << report;
   ASSERT_TRUE(r.error.empty()) << r.error;
@@ -292,7 +296,8 @@ TEST_F(ExternalScenario, SoemSimpleTestRunsToTheEndInOp) {
   };
   RunOptions options;
   options.pcapDir = dir_;
-  auto r = runExternalScenario(*s, options, external);
+  options.external = external;
+  auto r = runScenario(*s, options);
   const std::string report = formatReport(r);
   std::cout << report;
   ASSERT_TRUE(r.error.empty()) << r.error;

@@ -7,7 +7,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "scenario/runner.hpp"
+#include "scenario/engine.hpp"
 #include "scenario/scenario.hpp"
 #include "support/fifo.hpp"
 
@@ -252,6 +252,51 @@ TEST(Runner, ReportsTheMastersEventsAndCountsThem) {
       << report;
   EXPECT_NE(report.find("back in OP"), std::string::npos) << report;
   EXPECT_EQ(report.find("restart"), std::string::npos) << report;  // the runner restarts nothing
+}
+
+// <Master kind="veth"> is our master over veth: a scenario for ours, with ours' rules
+// (Detected is judged, Output is refused), and --master switches only between our two.
+TEST(Engine, VethIsOurMasterAndMasterOverridesOnlyBetweenOurTwo) {
+  auto s = parseScenario(wrap("<Master kind=\"veth\"/>\n<Expect>\n"
+                              "<Detected condition=\"wkc-error\" withinCycles=\"5\"/>\n"
+                              "</Expect>\n"),
+                         "v.xml");
+  ASSERT_TRUE(s.ok()) << s.error().message();
+  EXPECT_EQ(s->masterKind, "veth");
+  auto refused = parseScenario(wrap("<Master kind=\"veth\"/>\n<Expect>\n"
+                                    "<Output contains=\"x\"/>\n</Expect>\n"),
+                               "o.xml");
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().context.find("o.xml, line 5"), std::string::npos)
+      << refused.error().context;
+  auto unknown = parseScenario(wrap("<Master kind=\"vteh\"/>\n<Expect>\n"
+                                    "<State slave=\"A\" state=\"OP\"/>\n</Expect>\n"),
+                               "k.xml");
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_NE(unknown.error().context.find("in-process, veth or external"), std::string::npos)
+      << unknown.error().context;
+
+  RunOptions o;
+  EXPECT_EQ(*masterKindFor(*s, o), "veth");
+  o.master = "in-process";
+  EXPECT_EQ(*masterKindFor(*s, o), "in-process");
+  o.master = "external";
+  auto noCommand = masterKindFor(*s, o);
+  ASSERT_FALSE(noCommand.ok());
+  EXPECT_NE(noCommand.error().message().find("v.xml, line 3"), std::string::npos)
+      << noCommand.error().message();
+  Scenario external = *s;
+  external.masterKind = "external";
+  external.masterCommand = "true";
+  o.master = "veth";
+  auto ours = masterKindFor(external, o);
+  ASSERT_FALSE(ours.ok());
+  EXPECT_NE(ours.error().message().find("written for an external master"), std::string::npos)
+      << ours.error().message();
+  // The run says so too, judging nothing.
+  const auto r = runScenario(external, o);
+  EXPECT_FALSE(r.error.empty());
+  EXPECT_TRUE(r.results.empty());
 }
 
 }  // namespace

@@ -1,9 +1,10 @@
 // `ecsim scenario run FILE... [--seed N] [--pcap DIR] [--junit FILE] [--no-recovery]
-// [--shard I/N]`: runs
-// scenario files (docs/scenarios.md) with our master in-process on virtual time, or with an
-// external master command over a veth pair in real time (<Master kind="external">), prints a
-// report per expectation and exits non-zero when any expectation fails or a scenario cannot
-// run. An external master's output is kept next to the capture (--pcap DIR) or the JUnit
+// [--shard I/N] [--master in-process|veth]`: runs scenario files (docs/scenarios.md) on the
+// scenario engine (scenario/engine.hpp) with the master each file's <Master kind> names: ours
+// in-process on virtual time, ours over a veth pair in real time, or an external master
+// command over a veth pair (<Master kind="external">); `--master veth` runs the scenarios
+// written for our master over veth instead. Prints a report per expectation and exits
+// non-zero when any expectation fails or a scenario cannot run. An external master's output is kept next to the capture (--pcap DIR) or the JUnit
 // file as <scenario name>.output.txt. `--shard I/N` runs the I-th of N stable subsets of the
 // files (by position in the sorted list, round robin), so a CI matrix of N jobs runs each file
 // once and their JUnit files merge.
@@ -21,8 +22,7 @@
 #include <string>
 #include <vector>
 
-#include "scenario/external_runner.hpp"
-#include "scenario/runner.hpp"
+#include "scenario/engine.hpp"
 #include "scenario/scenario.hpp"
 #include "tools/ecsim/commands.hpp"
 
@@ -35,7 +35,8 @@ struct ScenarioOptions {
   std::string pcapDir;
   std::string junit;
   bool noRecovery{false};
-  std::string shard;  // "I/N"
+  std::string shard;   // "I/N"
+  std::string master;  // empty: each file's <Master kind>
 };
 
 struct Shard {
@@ -99,16 +100,16 @@ int runScenarios(const ScenarioOptions& o) {
   scenario::RunOptions run;
   run.seed = o.seed;
   run.recovery = !o.noRecovery;
+  run.master = o.master;
   if (!o.pcapDir.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(o.pcapDir, ec);
     run.pcapDir = o.pcapDir;
   }
-  scenario::ExternalRunOptions external;
   if (!o.pcapDir.empty()) {
-    external.outputDir = o.pcapDir;
+    run.external.outputDir = o.pcapDir;
   } else if (!o.junit.empty()) {
-    external.outputDir = std::filesystem::absolute(o.junit).parent_path();
+    run.external.outputDir = std::filesystem::absolute(o.junit).parent_path();
   }
   std::vector<scenario::ScenarioResult> results;
   bool allPassed = true;
@@ -129,7 +130,7 @@ int runScenarios(const ScenarioOptions& o) {
       allPassed = false;
       continue;
     }
-    auto result = scenario::runAnyScenario(*loaded, run, external);
+    auto result = scenario::runScenario(*loaded, run);
     result.wallSeconds = seconds();
     fmt::print("{}\n", scenario::formatReport(result));
     allPassed = allPassed && result.passed();
@@ -165,6 +166,11 @@ CommandRunner addScenarioCommand(CLI::App& app) {
   run->add_option("--shard", opts->shard,
                   "Run the I-th of N stable subsets of the files (I/N, e.g. 2/4): the sorted "
                   "list, every N-th from the I-th");
+  run->add_option("--master", opts->master,
+                  "Run the scenarios written for our master with it in-process (virtual time) "
+                  "or over a veth pair (real time; needs CAP_NET_ADMIN, CAP_NET_RAW, "
+                  "CAP_SYS_ADMIN)")
+      ->check(CLI::IsMember({"in-process", "veth"}));
   return [opts] { return runScenarios(*opts); };
 }
 
