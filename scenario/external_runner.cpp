@@ -204,7 +204,7 @@ void ExternalRun::tick() {
     const auto& a = s_.actions[i];
     if (applied_[i] || !((a.cycle && cycle >= *a.cycle) || (a.time && since >= *a.time))) continue;
     applied_[i] = true;
-    auto done = faults_->apply(a.action, now);
+    auto done = faults_->apply(a.fault, now, a.action.where);
     serverLog_.push_back({now, fmt::format("cycle {:>6}  {}: {}", cycle, a.action.text(),
                                            done.ok() ? *done : "ERROR " + done.error().context)});
     if (!done.ok() && serverError_.empty()) serverError_ = done.error().context;

@@ -249,20 +249,29 @@ ExpectationResult Run::evaluatePoint(const Expectation& x) {
       break;
     }
     case ExpectKind::kVariable: {
-      const std::uint16_t station = seg.slave(*slave).esc().read(reg::kConfiguredStationAddress);
       std::optional<std::size_t> position;
-      for (const auto& info : master_->slaves()) {
-        if (info.station == station) position = info.position;
+      if (slave) {
+        const std::uint16_t station = seg.slave(*slave).esc().read(reg::kConfiguredStationAddress);
+        for (const auto& info : master_->slaves()) {
+          if (info.station == station) position = info.position;
+        }
       }
       std::optional<master::ProcessVariable> var;
-      if (position) {
+      if (!x.variable.empty()) {  // by name (checked at the start of the run)
+        if (auto v = master::findVariable(master_->variables(), x.variable); v.ok()) {
+          var = master::ProcessVariable{v->position, v->output, v->bitOffset, v->bitLength,
+                                        v->index,    v->subindex, {}, v->entry};
+        }
+      } else if (position) {
         for (const auto& v : master::processVariables(master_->layout())) {
           if (v.position == *position && v.index == x.index && v.subindex == x.subindex) var = v;
         }
       }
       if (!var) {
-        res.observed = fmt::format("no process-data entry {:#06x}:{:02x} of {} in the image",
-                                   x.index, x.subindex, x.slave);
+        res.observed = x.variable.empty()
+                           ? fmt::format("no process-data entry {:#06x}:{:02x} of {} in the image",
+                                         x.index, x.subindex, x.slave)
+                           : "no process variable '" + x.variable + "'";
         break;
       }
       auto image = master_->image();
@@ -428,6 +437,12 @@ ScenarioResult Run::execute() {
     segment.setCableObserver(0, 0, nullptr);
     return r_;
   }
+  // <Variable name="..."> names exist now that the master has scanned.
+  if (auto names = checkVariableNames(s_, master_->variables()); !names.ok()) {
+    r_.error = names.error().context;
+    segment.setCableObserver(0, 0, nullptr);
+    return r_;
+  }
   master_->resetStatistics();  // the scenario's figures, from the moment all slaves are in OP
   t0_ = clock_.now();
   learnStations();
@@ -461,17 +476,12 @@ ScenarioResult Run::execute() {
       if ((a.cycle && cycle >= *a.cycle) || (a.time && sinceOp() >= *a.time)) {
         applied[i] = true;
         std::string what;
-        if (a.action.verb == "pause-master") {
-          auto d = a.action.millis("durationMs");
-          if (!d.ok()) {
-            r_.error = d.error().context;
-            return r_;
-          }
-          pausedUntil = saturatingAdd(clock_.now(), *d);
+        if (const auto* pause = std::get_if<topology::PauseMaster>(&a.fault)) {
+          pausedUntil = saturatingAdd(clock_.now(), pause->duration);
           what = fmt::format("the master sends nothing for {} ms",
-                             number(static_cast<double>(*d) / kNsPerMs));
+                             number(static_cast<double>(pause->duration) / kNsPerMs));
         } else {
-          auto done = faults.apply(a.action, clock_.now());
+          auto done = faults.apply(a.fault, clock_.now(), a.action.where);
           if (!done.ok()) {
             r_.error = done.error().context;
             return r_;

@@ -14,6 +14,7 @@
 
 #include "config/topology_file.hpp"
 #include "config/xml_util.hpp"
+#include "master/variables.hpp"
 #include "protocol/closest_name.hpp"
 #include "protocol/read_file.hpp"
 #include "scenario/command_output.hpp"
@@ -41,8 +42,10 @@ const xml::Names kMasterNames{{"kind", "command", "startTimeoutMs", "stopGraceMs
 const xml::Names kTimelineNames{{}, {"Action"}};
 const std::map<std::string_view, xml::Names, std::less<>> kExpectationNames{
     {"State", {{"slave", "state", "error", "code", "cycle", "atMs", "needsRecovery"}}},
-    {"Detected", {{"condition", "slave", "afterCycle", "withinCycles", "needsRecovery"}}},
-    {"BackInOp", {{"afterCycle", "afterMs", "withinMs", "needsRecovery"}}},
+    {"Detected",
+     {{"condition", "slave", "afterCycle", "afterMs", "withinCycles", "withinMs",
+       "needsRecovery"}}},
+    {"BackInOp", {{"afterCycle", "afterMs", "withinCycles", "withinMs", "needsRecovery"}}},
     {"Register",
      {{"slave", "address", "width", "mask", "op", "value", "tolerance", "cycle", "atMs",
        "needsRecovery"}}},
@@ -50,7 +53,7 @@ const std::map<std::string_view, xml::Names, std::less<>> kExpectationNames{
      {{"name", "slave", "op", "value", "tolerance", "cycle", "atMs", "needsRecovery"}}},
     {"Continuity", {{"maxBadCycles", "maxConsecutiveBadCycles", "needsRecovery"}}},
     {"Variable",
-     {{"slave", "entry", "mask", "signed", "op", "value", "tolerance", "cycle", "atMs",
+     {{"name", "slave", "entry", "mask", "signed", "op", "value", "tolerance", "cycle", "atMs",
        "needsRecovery"}}},
     // cycle and atMs are refused below with the reason (judged when the command has ended).
     {"ExitStatus", {{"op", "value", "tolerance", "needsRecovery", "cycle", "atMs"}}},
@@ -65,8 +68,6 @@ const xml::Names kExpectNames = [] {  // the expectations above
 }();
 // An <Action>'s own attributes; the others are its verb's arguments.
 constexpr std::array<std::string_view, 3> kActionAttributes{"cycle", "timeMs", "do"};
-// The runner's own verb (scenario/runner.cpp), beside the network's (topology/faults.hpp).
-constexpr std::string_view kPauseMaster = "pause-master";
 
 class Reader {
  public:
@@ -148,23 +149,22 @@ Result<Compare> parseCompare(const Reader& r, const XMLElement* e) {
   return r.error(e, "op=\"" + op + "\" is not one of eq, ne, lt, le, gt, ge");
 }
 
-Result<TimedAction> readAction(const Reader& r, const XMLElement* e) {
+// `cycleTime`: our master's, for durationCycles (0 for an external master, which keeps its own).
+Result<TimedAction> readAction(const Reader& r, const XMLElement* e, SimTime cycleTime) {
   TimedAction a;
   a.line = e->GetLineNum();
   a.action.where = r.where(e);
   auto verb = Reader::attr(e, "do");
   if (!verb) return r.error(e, "an Action needs do=\"VERB\"");
   a.action.verb = *verb;
-  std::vector<std::string_view> verbs = topology::faultVerbs();
-  verbs.push_back(kPauseMaster);
+  const std::vector<std::string_view> verbs = topology::faultVerbs(topology::FaultScope::kScenario);
   if (std::find(verbs.begin(), verbs.end(), a.action.verb) == verbs.end()) {
     return r.error(e, unknownNameText("action", a.action.verb, verbs));
   }
   // Its verb's arguments and the Action's own attributes; a misspelt one is an error naming the
   // closest of them ("delay: unknown argument 'durationMS'; did you mean 'durationMs'?").
-  std::vector<std::string_view> keys = a.action.verb == kPauseMaster
-                                           ? std::vector<std::string_view>{"durationMs"}
-                                           : topology::faultArguments(a.action.verb);
+  std::vector<std::string_view> keys =
+      topology::faultArguments(a.action.verb, topology::FaultScope::kScenario);
   keys.insert(keys.end(), kActionAttributes.begin(), kActionAttributes.end());
   for (const auto* at = e->FirstAttribute(); at != nullptr; at = at->Next()) {
     if (std::find(keys.begin(), keys.end(), at->Name()) == keys.end()) {
@@ -182,15 +182,31 @@ Result<TimedAction> readAction(const Reader& r, const XMLElement* e) {
     if (key == "cycle" || key == "timeMs" || key == "do") continue;
     a.action.args[key] = at->Value();
   }
-  if (a.action.verb == kPauseMaster) {
-    ECSIM_TRY(a.action.millis("durationMs"));  // required, and in range
-  } else {
-    ECSIM_TRY(topology::checkFaultArguments(a.action));
-  }
+  // Every argument now, not when the timeline reaches the action.
+  ECSIM_ASSIGN_OR_RETURN(a.fault,
+                         topology::parseFault(a.action, {topology::FaultScope::kScenario, cycleTime}));
   return a;
 }
 
-Result<Expectation> readExpectation(const Reader& r, const XMLElement* e) {
+// Cycles of our master in a time: the first cycle starting at or after `t` (a moment), or as
+// many cycles as cover `t` (a span).
+std::uint64_t cyclesIn(SimTime t, SimTime cycleTime) {
+  return cycleTime == 0 ? 0 : static_cast<std::uint64_t>((t + cycleTime - 1) / cycleTime);
+}
+
+// At most one of a moment's or span's two forms, NAMEMs and NAMECycle(s) (docs/scenarios.md:
+// "either, never both").
+Status notBoth(const Reader& r, const XMLElement* e, const char* cycles, const char* ms) {
+  if (e->Attribute(cycles) != nullptr && e->Attribute(ms) != nullptr) {
+    return r.error(e, fmt::format("{} takes {}=\"N\" or {}=\"T\", not both", e->Name(), cycles,
+                                  ms));
+  }
+  return okStatus();
+}
+
+// `cycleTime`: our master's, which converts times to cycles and back (0 for an external master,
+// whose cycles are the process-data frames it sends).
+Result<Expectation> readExpectation(const Reader& r, const XMLElement* e, SimTime cycleTime) {
   Expectation x;
   x.line = e->GetLineNum();
   const std::string tag = e->Name();
@@ -199,6 +215,9 @@ Result<Expectation> readExpectation(const Reader& r, const XMLElement* e) {
     return r.error(e, "unknown expectation <" + tag + ">");
   }
   ECSIM_TRY(xml::checkNames(r.context(), e, table->second));
+  ECSIM_TRY(notBoth(r, e, "cycle", "atMs"));
+  ECSIM_TRY(notBoth(r, e, "afterCycle", "afterMs"));
+  ECSIM_TRY(notBoth(r, e, "withinCycles", "withinMs"));
   ECSIM_ASSIGN_OR_RETURN(x.atCycle, r.number(e, "cycle", 0, kMaxCycles));
   ECSIM_ASSIGN_OR_RETURN(x.atTime, r.millis(e, "atMs"));
   ECSIM_ASSIGN_OR_RETURN(auto needs, r.boolean(e, "needsRecovery"));
@@ -240,20 +259,36 @@ Result<Expectation> readExpectation(const Reader& r, const XMLElement* e) {
       }
       return r.error(e, "condition must be one of " + names);
     }
+    // Counted in cycles; times are converted with the cycle time (our master's only).
     ECSIM_ASSIGN_OR_RETURN(auto after, r.number(e, "afterCycle", 0, kMaxCycles));
+    ECSIM_ASSIGN_OR_RETURN(auto afterMs, r.millis(e, "afterMs"));
     ECSIM_ASSIGN_OR_RETURN(auto within, r.number(e, "withinCycles", 0, kMaxCycles));
-    if (!within) return r.error(e, "Detected needs withinCycles=\"N\"");
-    x.afterCycle = after.value_or(0);
-    x.withinCycles = *within;
+    ECSIM_ASSIGN_OR_RETURN(auto withinMs, r.millis(e, "withinMs"));
+    if (!within && !withinMs) {
+      return r.error(e, "Detected needs withinCycles=\"N\" or withinMs=\"T\"");
+    }
+    x.afterCycle = after ? *after : afterMs ? cyclesIn(*afterMs, cycleTime) : 0;
+    x.withinCycles = within ? *within : cyclesIn(*withinMs, cycleTime);
   } else if (tag == "BackInOp") {
     x.kind = ExpectKind::kBackInOp;
     ECSIM_ASSIGN_OR_RETURN(auto after, r.number(e, "afterCycle", 0, kMaxCycles));
+    ECSIM_ASSIGN_OR_RETURN(auto afterMs, r.millis(e, "afterMs"));
     ECSIM_ASSIGN_OR_RETURN(auto within, r.millis(e, "withinMs"));
-    ECSIM_ASSIGN_OR_RETURN(x.afterTime, r.millis(e, "afterMs"));
-    if (!within) return r.error(e, "BackInOp needs withinMs=\"T\"");
-    if (after && x.afterTime) return r.error(e, "BackInOp takes afterCycle or afterMs, not both");
+    ECSIM_ASSIGN_OR_RETURN(auto withinCycles, r.number(e, "withinCycles", 0, kMaxCycles));
+    if (!within && !withinCycles) {
+      return r.error(e, "BackInOp needs withinMs=\"T\" or withinCycles=\"N\"");
+    }
+    if (withinCycles && cycleTime == 0) {
+      return r.error(e, "withinCycles needs our master's cycle time (an external master keeps "
+                        "its own): give withinMs");
+    }
+    x.within = within ? *within : saturatingMul(static_cast<SimTime>(*withinCycles), cycleTime);
     x.afterCycle = after.value_or(0);
-    x.within = *within;
+    if (afterMs && cycleTime != 0) {
+      x.afterCycle = cyclesIn(*afterMs, cycleTime);  // ours: the cycle starting then
+    } else {
+      x.afterTime = afterMs;  // an external master's: a time after time zero
+    }
   } else if (tag == "ExitStatus" || tag == "Output") {
     // External masters: judged once the command has ended.
     if (x.atCycle || x.atTime) {
@@ -318,8 +353,24 @@ Result<Expectation> readExpectation(const Reader& r, const XMLElement* e) {
     x.maxConsecutiveBadCycles = run.value_or(UINT64_MAX);
   } else if (tag == "Variable") {
     x.kind = ExpectKind::kVariable;
-    ECSIM_TRY(needSlave());
     ECSIM_TRY(needValue());
+    // By the master's name for it ("Drive1.Statusword", looked up when the master has scanned:
+    // checkVariableNames), or by slave and entry.
+    if (auto name = Reader::attr(e, "name")) {
+      if (name->empty()) return r.error(e, "Variable name=\"\" is empty");
+      if (e->Attribute("slave") != nullptr || e->Attribute("entry") != nullptr) {
+        return r.error(e, "Variable takes name=\"SLAVE.ENTRY\" or slave and entry, not both");
+      }
+      x.variable = *name;
+      ECSIM_ASSIGN_OR_RETURN(auto mask, r.number(e, "mask", 0, 0xFFFFFFFF));
+      x.mask = static_cast<std::uint32_t>(mask.value_or(0xFFFFFFFF));
+      ECSIM_ASSIGN_OR_RETURN(auto isSigned, r.boolean(e, "signed"));
+      x.isSigned = isSigned.value_or(false);
+      return x;
+    }
+    if (x.slave.empty()) {
+      return r.error(e, "Variable needs name=\"SLAVE.ENTRY\" or slave=\"NAME\" entry=\"0xINDEX:SUB\"");
+    }
     const auto entry = Reader::attr(e, "entry").value_or("");
     const auto colon = entry.find(':');
     auto index = topology::parseNumber(entry.substr(0, colon));
@@ -392,8 +443,11 @@ Status checkWithinRun(const Reader& r, const XMLElement* e, const Scenario& s,
   if (end.external) return okStatus();
   if (x.atCycle && *x.atCycle > end.cycles) return afterTheEnd(r, e, "cycle", cycles);
   const bool window = x.kind == ExpectKind::kDetected || x.kind == ExpectKind::kBackInOp;
-  if (window && e->Attribute("afterCycle") != nullptr && x.afterCycle >= end.cycles) {
-    return afterTheEnd(r, e, "afterCycle", fmt::format("its last cycle is {}", end.cycles - 1));
+  const char* after = e->Attribute("afterCycle") != nullptr ? "afterCycle"
+                      : e->Attribute("afterMs") != nullptr  ? "afterMs"
+                                                            : nullptr;
+  if (window && after != nullptr && x.afterCycle >= end.cycles) {
+    return afterTheEnd(r, e, after, fmt::format("its last cycle is {}", end.cycles - 1));
   }
   return okStatus();
 }
@@ -471,6 +525,17 @@ Status checkTopologyNames(const Scenario& s, const TopologyConfig& topology) {
   return okStatus();
 }
 
+Status checkVariableNames(const Scenario& s, const std::vector<master::VariableInfo>& variables) {
+  for (const auto& x : s.expectations) {
+    if (x.kind != ExpectKind::kVariable || x.variable.empty()) continue;
+    if (auto v = master::findVariable(variables, x.variable); !v.ok()) {
+      return makeError(ErrorCode::kNotFound, fmt::format("{}, line {}: {}", s.file.string(),
+                                                         x.line, v.error().context));
+    }
+  }
+  return okStatus();
+}
+
 Result<Scenario> parseScenario(std::string_view xml, const std::filesystem::path& path) {
   Reader r(path.string());
   tinyxml2::XMLDocument doc;
@@ -529,7 +594,8 @@ Result<Scenario> parseScenario(std::string_view xml, const std::filesystem::path
       if (std::string_view(e->Name()) != "Action") {
         return r.error(e, "the Timeline holds <Action> elements only");
       }
-      ECSIM_ASSIGN_OR_RETURN(auto a, readAction(r, e));
+      ECSIM_ASSIGN_OR_RETURN(
+          auto a, readAction(r, e, s.masterKind == "external" ? SimTime{0} : s.cycleTime));
       ECSIM_TRY(checkWithinRun(r, e, s, a));
       s.actions.push_back(std::move(a));
     }
@@ -537,7 +603,8 @@ Result<Scenario> parseScenario(std::string_view xml, const std::filesystem::path
   if (const auto* x = root->FirstChildElement("Expect")) {
     ECSIM_TRY(xml::checkNames(r.context(), x, kExpectNames));
     for (const auto* e = x->FirstChildElement(); e != nullptr; e = e->NextSiblingElement()) {
-      ECSIM_ASSIGN_OR_RETURN(auto exp, readExpectation(r, e));
+      ECSIM_ASSIGN_OR_RETURN(
+          auto exp, readExpectation(r, e, s.masterKind == "external" ? SimTime{0} : s.cycleTime));
       ECSIM_TRY(checkWithinRun(r, e, s, exp));
       s.expectations.push_back(std::move(exp));
     }
@@ -554,7 +621,7 @@ Status checkMasterKind(const Scenario& s) {
                      s.file.string() + ", line " + std::to_string(line) + ": " + what);
   };
   for (const auto& a : s.actions) {
-    if (external && a.action.verb == "pause-master") {
+    if (external && std::holds_alternative<topology::PauseMaster>(a.fault)) {
       return refuse(a.line,
                     "pause-master needs our master: an external master sends what it sends");
     }
@@ -575,9 +642,6 @@ Status checkMasterKind(const Scenario& s) {
     if (!external && commandOnly) {
       return refuse(x.line, std::string(x.kind == ExpectKind::kOutput ? "Output" : "ExitStatus") +
                                 " judges an external master's command (Master kind=\"external\")");
-    }
-    if (!external && x.afterTime) {
-      return refuse(x.line, "BackInOp afterMs is for external masters; ours counts afterCycle");
     }
   }
   return okStatus();

@@ -44,6 +44,28 @@ TEST(ScenarioFile, ReadsActionsAndExpectations) {
   EXPECT_EQ(s->expectations[0].line, 8);
 }
 
+// Issue #16: moments and spans in ms or in cycles; ours converts one into the other with its
+// cycle time (here 1000 us; a time between two cycle starts means the next cycle).
+TEST(ScenarioFile, TimesInMillisecondsOrCycles) {
+  auto s = parseScenario(
+      wrap("<Timeline>\n"
+           "  <Action cycle=\"5\" do=\"delay\" cable=\"drives\" ns=\"800\" durationCycles=\"30\"/>\n"
+           "  <Action cycle=\"40\" do=\"pause-master\" durationCycles=\"12\"/>\n"
+           "</Timeline>\n<Expect>\n"
+           "  <Detected condition=\"slave-lost\" afterMs=\"40.5\" withinMs=\"10\"/>\n"
+           "  <BackInOp afterMs=\"60\" withinCycles=\"25\"/>\n"
+           "</Expect>\n"),
+      "/x/s.xml");
+  ASSERT_TRUE(s.ok()) << s.error().message();
+  EXPECT_EQ(std::get<topology::Delay>(s->actions[0].fault).duration, 30 * kNsPerMs);
+  EXPECT_EQ(std::get<topology::PauseMaster>(s->actions[1].fault).duration, 12 * kNsPerMs);
+  EXPECT_EQ(s->expectations[0].afterCycle, 41u);
+  EXPECT_EQ(s->expectations[0].withinCycles, 10u);
+  EXPECT_EQ(s->expectations[1].afterCycle, 60u);
+  EXPECT_FALSE(s->expectations[1].afterTime) << "ours counts cycles";
+  EXPECT_EQ(s->expectations[1].within, 25 * kNsPerMs);
+}
+
 TEST(ScenarioFile, ErrorsNameFileAndLine) {
   auto s = parseScenario(wrap("<Timeline>\n  <Action do=\"link-down\"/>\n</Timeline>\n"
                               "<Expect><State slave=\"A\" state=\"OP\"/></Expect>\n"),
