@@ -9,6 +9,7 @@
 // the closest name or on another line, and 3 (control lines: the verb table of commit 46b5a62)
 // passed as now.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -71,14 +72,25 @@ std::string masterFile(const std::string& slave) {  // the slave on line 2
   return "<EcsimMaster>\n" + slave + "\n</EcsimMaster>\n";
 }
 
+// One folder per process, removed at its end: ctest -j runs the rows in parallel processes,
+// and one writing net.xml while another read it made a row fail now and then.
+struct CaseDir {
+  std::filesystem::path path;
+  CaseDir()
+      : path(std::filesystem::temp_directory_path() /
+             ("ecsim_strict_inputs_test." + std::to_string(::getpid()))) {
+    std::filesystem::create_directories(path);
+    std::ofstream(path / "net.xml") << kNet;
+  }
+  ~CaseDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path, ec);
+  }
+};
+
 const std::filesystem::path& caseDir() {
-  static const std::filesystem::path dir = [] {
-    auto d = std::filesystem::temp_directory_path() / "ecsim_strict_inputs_test";
-    std::filesystem::create_directories(d);
-    std::ofstream(d / "net.xml") << kNet;
-    return d;
-  }();
-  return dir;
+  static const CaseDir dir;
+  return dir.path;
 }
 
 // The error of reading the row's text (empty when it was accepted), and the file it names.
