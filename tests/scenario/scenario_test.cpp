@@ -163,6 +163,38 @@ TEST(Runner, AFailingExpectationSaysWhatWhenAndWhat) {
   EXPECT_NE(junit.find("<failure message=\"at 700.000 ms: SAFEOP"), std::string::npos) << junit;
 }
 
+// Issue #16 item 3: a <Variable> by the name the master gives it from the topology's slave
+// names; the names exist once the master has scanned, so the runner checks them when the run
+// starts and a name not found is a scenario error listing the closest names.
+TEST(Runner, VariablesByTheirNames) {
+  auto s = loadScenario(kDir / "drive_fault.xml");
+  ASSERT_TRUE(s.ok()) << s.error().message();
+  s->duration = 400 * kNsPerMs;
+  s->actions.clear();
+  s->expectations.clear();
+  Expectation x;
+  x.line = 41;
+  x.kind = ExpectKind::kVariable;
+  x.variable = "Drive1.Statusword";
+  // The runner writes no controlword: the drive stays in Switch on disabled (CiA 402,
+  // statusword xxxx xxxx x1xx 0000).
+  x.mask = 0x004F;
+  x.value = 0x0040;
+  x.atCycle = 300;
+  s->expectations.push_back(x);
+  auto r = runScenario(*s);
+  ASSERT_TRUE(r.error.empty()) << r.error;
+  ASSERT_EQ(r.results.size(), 1u);
+  EXPECT_TRUE(r.results[0].passed) << r.results[0].observed;
+  EXPECT_EQ(r.results[0].what, "Variable Drive1.Statusword == 64 at cycle 300");
+
+  s->expectations[0].variable = "Drive1.StatusWord";
+  r = runScenario(*s);
+  EXPECT_EQ(r.error.rfind((kDir / "drive_fault.xml").string() + ", line 41: ", 0), 0u) << r.error;
+  EXPECT_NE(r.error.find("'Drive1.StatusWord'; closest: Drive1.Statusword"), std::string::npos)
+      << r.error;
+}
+
 std::string slurp(const std::filesystem::path& p) {
   std::ifstream in(p, std::ios::binary);
   std::stringstream ss;

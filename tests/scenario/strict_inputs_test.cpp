@@ -366,6 +366,10 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"BackInOp withinCycles and withinMs", Format::kScenario,
              expect("<BackInOp afterCycle=\"5\" withinCycles=\"50\" withinMs=\"50\"/>"), 3,
              "BackInOp takes withinCycles=\"N\" or withinMs=\"T\", not both"},
+        Case{"Variable name and entry", Format::kScenario,
+             expect("<Variable name=\"Drive1.Statusword\" slave=\"Drive1\" entry=\"0x6041:0\" "
+                    "value=\"0\"/>"),
+             3, "Variable takes name=\"SLAVE.ENTRY\" or slave and entry, not both"},
         Case{"Detected afterMs after the end", Format::kScenario,
              expect("<Detected condition=\"slave-lost\" afterMs=\"99.5\" withinMs=\"5\"/>"), 3,
              "afterMs=\"99.5\" is after the end of the run (its last cycle is 99)"}));
