@@ -6,6 +6,7 @@
 #include "protocol/ethernet.hpp"
 #include "protocol/frame.hpp"
 #include "slavesim/generic_slave.hpp"
+#include "topology/control_server.hpp"
 #include "topology/faults.hpp"
 #include "topology/network_builder.hpp"
 
@@ -358,6 +359,23 @@ TEST(TypedFaults, NamesAndPlacesAreCheckedWhenParsed) {
     EXPECT_NE(f.error().context.find(expected), std::string::npos)
         << line << ": " << f.error().context;
   }
+}
+
+// The control socket's answer to a line: parsed first (nothing applied when an argument is
+// wrong), then applied; errors say "control" and the verb.
+TEST(TypedFaults, ControlLinesAreParsedThenApplied) {
+  Network net = makeLine(3);
+  FaultInjector faults(net, 1);
+  EXPECT_EQ(answerFaultLine(faults, "loss rate=1.5 cable=c1", 0),
+            "error control: loss: rate=1.5 is not a number in [0, 1]");
+  auto frame = brdFrame();
+  EXPECT_TRUE(net.segment->processFrame(frame, 0).delivered) << "nothing was applied";
+  EXPECT_EQ(answerFaultLine(faults, "link-down cable=c3", 0),
+            "error control: link-down: no cable named 'c3'; did you mean 'c1'?");
+  EXPECT_EQ(answerFaultLine(faults, "link-down cable=c2", 0), "ok link down at S2 port 0");
+  EXPECT_EQ(answerFaultLine(faults, "pause-master durationMs=5", 0).rfind(
+                "error control: unknown action 'pause-master'", 0),
+            0u);
 }
 
 // A scenario's durations in cycles of its master: exactly one of durationMs and durationCycles.
