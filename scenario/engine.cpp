@@ -31,17 +31,16 @@ std::string number(double v) {
 Result<std::string> applyAction(const TimedAction& a, const MasterUnderTest& master,
                                 topology::FaultInjector& faults, SimTime now,
                                 SimTime& pausedUntil) {
-  if (a.action.verb == "pause-master") {
+  if (const auto* pause = std::get_if<topology::PauseMaster>(&a.fault)) {
     if (!master.pausable()) {
       return makeError(ErrorCode::kInvalidArgument,
                        fmt::format("line {}: pause-master needs our master", a.line));
     }
-    ECSIM_ASSIGN_OR_RETURN(auto d, a.action.millis("durationMs"));
-    pausedUntil = saturatingAdd(now, d);
+    pausedUntil = saturatingAdd(now, pause->duration);
     return fmt::format("the master sends nothing for {} ms",
-                       number(static_cast<double>(d) / kNsPerMs));
+                       number(static_cast<double>(pause->duration) / kNsPerMs));
   }
-  return faults.apply(a.action, now);
+  return faults.apply(a.fault, now, a.action.where);
 }
 
 Result<topology::Network> buildScenarioNetwork(const Scenario& scenario) {

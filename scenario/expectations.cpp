@@ -258,21 +258,30 @@ ExpectationResult Judge::evaluatePoint(const Expectation& x, SimTime since) cons
     res.observed = number(*v);
     res.passed = compareValues(*v, x.compare, x.value, x.tolerance);
   } else if (x.kind == ExpectKind::kVariable) {
-    const std::uint16_t station =
-        segment_.slave(*slave).esc().read(reg::kConfiguredStationAddress);
     std::optional<std::size_t> position;
-    for (const auto& info : master_->slaves()) {
-      if (info.station == station) position = info.position;
+    if (slave) {
+      const std::uint16_t station =
+          segment_.slave(*slave).esc().read(reg::kConfiguredStationAddress);
+      for (const auto& info : master_->slaves()) {
+        if (info.station == station) position = info.position;
+      }
     }
     std::optional<master::ProcessVariable> var;
-    if (position) {
+    if (!x.variable.empty()) {  // by name (checked when the master reached OP)
+      if (auto v = master::findVariable(master_->variables(), x.variable); v.ok()) {
+        var = master::ProcessVariable{v->position, v->output, v->bitOffset, v->bitLength,
+                                      v->index,    v->subindex, {}, v->entry};
+      }
+    } else if (position) {
       for (const auto& v : master::processVariables(master_->layout())) {
         if (v.position == *position && v.index == x.index && v.subindex == x.subindex) var = v;
       }
     }
     if (!var) {
-      res.observed = fmt::format("no process-data entry {:#06x}:{:02x} of {} in the image",
-                                 x.index, x.subindex, x.slave);
+      res.observed = x.variable.empty()
+                         ? fmt::format("no process-data entry {:#06x}:{:02x} of {} in the image",
+                                       x.index, x.subindex, x.slave)
+                         : "no process variable '" + x.variable + "'";
       return res;
     }
     auto image = master_->image();

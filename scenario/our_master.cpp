@@ -74,6 +74,8 @@ Status OurMaster::startMaster(Link& link, master::Bus& bus) {
   if (auto st = master_->start(); !st.ok()) {
     return makeError(st.error().code, "the master did not reach OP: " + st.error().message());
   }
+  // <Variable name="..."> names exist now that the master has scanned.
+  ECSIM_TRY(checkVariableNames(s, master_->variables()));
   master_->resetStatistics();  // the scenario's figures, from the moment all slaves are in OP
   zero_ = clock().now();
   nextStart_ = *zero_;

@@ -66,6 +66,7 @@ std::string Expectation::describe() const {
       return s;
     }
     case ExpectKind::kVariable:
+      if (!variable.empty()) return fmt::format("Variable {} {}{}", variable, cmp, when(*this));
       return fmt::format("Variable {} {:#06x}:{:02x} {}{}", slave, index, subindex, cmp,
                          when(*this));
     case ExpectKind::kExitStatus:

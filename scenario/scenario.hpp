@@ -33,6 +33,9 @@
 namespace ecsim {
 struct TopologyConfig;
 }
+namespace ecsim::master {
+struct VariableInfo;
+}
 
 namespace ecsim::scenario {
 
@@ -40,7 +43,8 @@ struct TimedAction {
   int line{0};
   std::optional<std::uint64_t> cycle;  // cycles after the master reached OP
   std::optional<SimTime> time;         // ns after the master reached OP
-  topology::FaultAction action;
+  topology::FaultAction action;        // as written (slave and cable names, logs)
+  topology::Fault fault;               // parsed when the file is read: every argument checked
 };
 
 enum class ExpectKind : std::uint8_t {
@@ -67,14 +71,15 @@ struct Expectation {
   std::optional<bool> error;          // kState: the AL status error flag
   std::optional<std::uint16_t> code;  // kState: AL status code
   std::string condition;              // kDetected
-  std::uint64_t afterCycle{0};        // kDetected, kBackInOp
+  std::uint64_t afterCycle{0};        // kDetected, kBackInOp (ours: afterMs converted)
   std::optional<SimTime> afterTime;   // kBackInOp, kOutput (afterMs; external masters only)
-  std::uint64_t withinCycles{0};      // kDetected
-  SimTime within{0};                  // kBackInOp, kOutput
+  std::uint64_t withinCycles{0};      // kDetected (withinMs converted)
+  SimTime within{0};                  // kBackInOp (withinCycles converted), kOutput
   std::uint16_t address{0};           // kRegister
   unsigned width{1};                  // kRegister bytes
   std::uint32_t mask{0xFFFFFFFF};     // kRegister: bits compared
   std::string name;                   // kStatistic
+  std::string variable;               // kVariable by name ("Drive1.Statusword"), else:
   std::uint16_t index{0};             // kVariable
   std::uint8_t subindex{0};
   bool isSigned{false};
@@ -126,6 +131,12 @@ Result<Scenario> parseScenario(std::string_view xml, const std::filesystem::path
 // Every slave and cable an action or expectation names is in the topology; the error names
 // the scenario's file and line and the closest name the topology has.
 Status checkTopologyNames(const Scenario& scenario, const TopologyConfig& topology);
+// <Variable name="Drive1.Statusword">: process-variable names exist once the master has
+// scanned (master/variables.hpp); the engine checks them against Master::variables() at the
+// start of the run. A name not found is an error naming the file, the line and the closest
+// names.
+Status checkVariableNames(const Scenario& scenario,
+                          const std::vector<master::VariableInfo>& variables);
 // What each master under test can be judged on: rejects (naming file and line) the
 // expectations that need the master's internals (Detected, Statistic, Variable, Continuity)
 // and the pause-master action for external masters, and ExitStatus, Output and BackInOp

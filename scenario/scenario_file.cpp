@@ -41,8 +41,10 @@ const xml::Names kMasterNames{{"kind", "command", "startTimeoutMs", "stopGraceMs
 const xml::Names kTimelineNames{{}, {"Action"}};
 const std::map<std::string_view, xml::Names, std::less<>> kExpectationNames{
     {"State", {{"slave", "state", "error", "code", "cycle", "atMs", "needsRecovery"}}},
-    {"Detected", {{"condition", "slave", "afterCycle", "withinCycles", "needsRecovery"}}},
-    {"BackInOp", {{"afterCycle", "afterMs", "withinMs", "needsRecovery"}}},
+    {"Detected",
+     {{"condition", "slave", "afterCycle", "afterMs", "withinCycles", "withinMs",
+       "needsRecovery"}}},
+    {"BackInOp", {{"afterCycle", "afterMs", "withinCycles", "withinMs", "needsRecovery"}}},
     {"Register",
      {{"slave", "address", "width", "mask", "op", "value", "tolerance", "cycle", "atMs",
        "needsRecovery"}}},
@@ -50,7 +52,7 @@ const std::map<std::string_view, xml::Names, std::less<>> kExpectationNames{
      {{"name", "slave", "op", "value", "tolerance", "cycle", "atMs", "needsRecovery"}}},
     {"Continuity", {{"maxBadCycles", "maxConsecutiveBadCycles", "needsRecovery"}}},
     {"Variable",
-     {{"slave", "entry", "mask", "signed", "op", "value", "tolerance", "cycle", "atMs",
+     {{"name", "slave", "entry", "mask", "signed", "op", "value", "tolerance", "cycle", "atMs",
        "needsRecovery"}}},
     // cycle and atMs are refused below with the reason (judged when the command has ended).
     {"ExitStatus", {{"op", "value", "tolerance", "needsRecovery", "cycle", "atMs"}}},
@@ -65,8 +67,6 @@ const xml::Names kExpectNames = [] {  // the expectations above
 }();
 // An <Action>'s own attributes; the others are its verb's arguments.
 constexpr std::array<std::string_view, 3> kActionAttributes{"cycle", "timeMs", "do"};
-// The runner's own verb (scenario/runner.cpp), beside the network's (topology/faults.hpp).
-constexpr std::string_view kPauseMaster = "pause-master";
 
 class Reader {
  public:
@@ -148,23 +148,22 @@ Result<Compare> parseCompare(const Reader& r, const XMLElement* e) {
   return r.error(e, "op=\"" + op + "\" is not one of eq, ne, lt, le, gt, ge");
 }
 
-Result<TimedAction> readAction(const Reader& r, const XMLElement* e) {
+// `cycleTime`: our master's, for durationCycles (0 for an external master, which keeps its own).
+Result<TimedAction> readAction(const Reader& r, const XMLElement* e, SimTime cycleTime) {
   TimedAction a;
   a.line = e->GetLineNum();
   a.action.where = r.where(e);
   auto verb = Reader::attr(e, "do");
   if (!verb) return r.error(e, "an Action needs do=\"VERB\"");
   a.action.verb = *verb;
-  std::vector<std::string_view> verbs = topology::faultVerbs();
-  verbs.push_back(kPauseMaster);
+  const std::vector<std::string_view> verbs = topology::faultVerbs(topology::FaultScope::kScenario);
   if (std::find(verbs.begin(), verbs.end(), a.action.verb) == verbs.end()) {
     return r.error(e, unknownNameText("action", a.action.verb, verbs));
   }
   // Its verb's arguments and the Action's own attributes; a misspelt one is an error naming the
   // closest of them ("delay: unknown argument 'durationMS'; did you mean 'durationMs'?").
-  std::vector<std::string_view> keys = a.action.verb == kPauseMaster
-                                           ? std::vector<std::string_view>{"durationMs"}
-                                           : topology::faultArguments(a.action.verb);
+  std::vector<std::string_view> keys =
+      topology::faultArguments(a.action.verb, topology::FaultScope::kScenario);
   keys.insert(keys.end(), kActionAttributes.begin(), kActionAttributes.end());
   for (const auto* at = e->FirstAttribute(); at != nullptr; at = at->Next()) {
     if (std::find(keys.begin(), keys.end(), at->Name()) == keys.end()) {
@@ -182,15 +181,31 @@ Result<TimedAction> readAction(const Reader& r, const XMLElement* e) {
     if (key == "cycle" || key == "timeMs" || key == "do") continue;
     a.action.args[key] = at->Value();
   }
-  if (a.action.verb == kPauseMaster) {
-    ECSIM_TRY(a.action.millis("durationMs"));  // required, and in range
-  } else {
-    ECSIM_TRY(topology::checkFaultArguments(a.action));
-  }
+  // Every argument now, not when the timeline reaches the action.
+  ECSIM_ASSIGN_OR_RETURN(a.fault,
+                         topology::parseFault(a.action, {topology::FaultScope::kScenario, cycleTime}));
   return a;
 }
 
-Result<Expectation> readExpectation(const Reader& r, const XMLElement* e) {
+// Cycles of our master in a time: the first cycle starting at or after `t` (a moment), or as
+// many cycles as cover `t` (a span).
+std::uint64_t cyclesIn(SimTime t, SimTime cycleTime) {
+  return cycleTime == 0 ? 0 : static_cast<std::uint64_t>((t + cycleTime - 1) / cycleTime);
+}
+
+// At most one of a moment's or span's two forms, NAMEMs and NAMECycle(s) (docs/scenarios.md:
+// "either, never both").
+Status notBoth(const Reader& r, const XMLElement* e, const char* cycles, const char* ms) {
+  if (e->Attribute(cycles) != nullptr && e->Attribute(ms) != nullptr) {
+    return r.error(e, fmt::format("{} takes {}=\"N\" or {}=\"T\", not both", e->Name(), cycles,
+                                  ms));
+  }
+  return okStatus();
+}
+
+// `cycleTime`: our master's, which converts times to cycles and back (0 for an external master,
+// whose cycles are the process-data frames it sends).
+Result<Expectation> readExpectation(const Reader& r, const XMLElement* e, SimTime cycleTime) {
   Expectation x;
   x.line = e->GetLineNum();
   const std::string tag = e->Name();
@@ -199,6 +214,9 @@ Result<Expectation> readExpectation(const Reader& r, const XMLElement* e) {
     return r.error(e, "unknown expectation <" + tag + ">");
   }
   ECSIM_TRY(xml::checkNames(r.context(), e, table->second));
+  ECSIM_TRY(notBoth(r, e, "cycle", "atMs"));
+  ECSIM_TRY(notBoth(r, e, "afterCycle", "afterMs"));
+  ECSIM_TRY(notBoth(r, e, "withinCycles", "withinMs"));
   ECSIM_ASSIGN_OR_RETURN(x.atCycle, r.number(e, "cycle", 0, kMaxCycles));
   ECSIM_ASSIGN_OR_RETURN(x.atTime, r.millis(e, "atMs"));
   ECSIM_ASSIGN_OR_RETURN(auto needs, r.boolean(e, "needsRecovery"));
@@ -240,20 +258,36 @@ Result<Expectation> readExpectation(const Reader& r, const XMLElement* e) {
       }
       return r.error(e, "condition must be one of " + names);
     }
+    // Counted in cycles; times are converted with the cycle time (our master's only).
     ECSIM_ASSIGN_OR_RETURN(auto after, r.number(e, "afterCycle", 0, kMaxCycles));
+    ECSIM_ASSIGN_OR_RETURN(auto afterMs, r.millis(e, "afterMs"));
     ECSIM_ASSIGN_OR_RETURN(auto within, r.number(e, "withinCycles", 0, kMaxCycles));
-    if (!within) return r.error(e, "Detected needs withinCycles=\"N\"");
-    x.afterCycle = after.value_or(0);
-    x.withinCycles = *within;
+    ECSIM_ASSIGN_OR_RETURN(auto withinMs, r.millis(e, "withinMs"));
+    if (!within && !withinMs) {
+      return r.error(e, "Detected needs withinCycles=\"N\" or withinMs=\"T\"");
+    }
+    x.afterCycle = after ? *after : afterMs ? cyclesIn(*afterMs, cycleTime) : 0;
+    x.withinCycles = within ? *within : cyclesIn(*withinMs, cycleTime);
   } else if (tag == "BackInOp") {
     x.kind = ExpectKind::kBackInOp;
     ECSIM_ASSIGN_OR_RETURN(auto after, r.number(e, "afterCycle", 0, kMaxCycles));
+    ECSIM_ASSIGN_OR_RETURN(auto afterMs, r.millis(e, "afterMs"));
     ECSIM_ASSIGN_OR_RETURN(auto within, r.millis(e, "withinMs"));
-    ECSIM_ASSIGN_OR_RETURN(x.afterTime, r.millis(e, "afterMs"));
-    if (!within) return r.error(e, "BackInOp needs withinMs=\"T\"");
-    if (after && x.afterTime) return r.error(e, "BackInOp takes afterCycle or afterMs, not both");
+    ECSIM_ASSIGN_OR_RETURN(auto withinCycles, r.number(e, "withinCycles", 0, kMaxCycles));
+    if (!within && !withinCycles) {
+      return r.error(e, "BackInOp needs withinMs=\"T\" or withinCycles=\"N\"");
+    }
+    if (withinCycles && cycleTime == 0) {
+      return r.error(e, "withinCycles needs our master's cycle time (an external master keeps "
+                        "its own): give withinMs");
+    }
+    x.within = within ? *within : saturatingMul(static_cast<SimTime>(*withinCycles), cycleTime);
     x.afterCycle = after.value_or(0);
-    x.within = *within;
+    if (afterMs && cycleTime != 0) {
+      x.afterCycle = cyclesIn(*afterMs, cycleTime);  // ours: the cycle starting then
+    } else {
+      x.afterTime = afterMs;  // an external master's: a time after time zero
+    }
   } else if (tag == "ExitStatus" || tag == "Output") {
     // External masters: judged once the command has ended.
     if (x.atCycle || x.atTime) {
@@ -318,8 +352,24 @@ Result<Expectation> readExpectation(const Reader& r, const XMLElement* e) {
     x.maxConsecutiveBadCycles = run.value_or(UINT64_MAX);
   } else if (tag == "Variable") {
     x.kind = ExpectKind::kVariable;
-    ECSIM_TRY(needSlave());
     ECSIM_TRY(needValue());
+    // By the master's name for it ("Drive1.Statusword", looked up when the master has scanned:
+    // checkVariableNames), or by slave and entry.
+    if (auto name = Reader::attr(e, "name")) {
+      if (name->empty()) return r.error(e, "Variable name=\"\" is empty");
+      if (e->Attribute("slave") != nullptr || e->Attribute("entry") != nullptr) {
+        return r.error(e, "Variable takes name=\"SLAVE.ENTRY\" or slave and entry, not both");
+      }
+      x.variable = *name;
+      ECSIM_ASSIGN_OR_RETURN(auto mask, r.number(e, "mask", 0, 0xFFFFFFFF));
+      x.mask = static_cast<std::uint32_t>(mask.value_or(0xFFFFFFFF));
+      ECSIM_ASSIGN_OR_RETURN(auto isSigned, r.boolean(e, "signed"));
+      x.isSigned = isSigned.value_or(false);
+      return x;
+    }
+    if (x.slave.empty()) {
+      return r.error(e, "Variable needs name=\"SLAVE.ENTRY\" or slave=\"NAME\" entry=\"0xINDEX:SUB\"");
+    }
     const auto entry = Reader::attr(e, "entry").value_or("");
     const auto colon = entry.find(':');
     auto index = topology::parseNumber(entry.substr(0, colon));
@@ -392,49 +442,16 @@ Status checkWithinRun(const Reader& r, const XMLElement* e, const Scenario& s,
   if (end.external) return okStatus();
   if (x.atCycle && *x.atCycle > end.cycles) return afterTheEnd(r, e, "cycle", cycles);
   const bool window = x.kind == ExpectKind::kDetected || x.kind == ExpectKind::kBackInOp;
-  if (window && e->Attribute("afterCycle") != nullptr && x.afterCycle >= end.cycles) {
-    return afterTheEnd(r, e, "afterCycle", fmt::format("its last cycle is {}", end.cycles - 1));
+  const char* after = e->Attribute("afterCycle") != nullptr ? "afterCycle"
+                      : e->Attribute("afterMs") != nullptr  ? "afterMs"
+                                                            : nullptr;
+  if (window && after != nullptr && x.afterCycle >= end.cycles) {
+    return afterTheEnd(r, e, after, fmt::format("its last cycle is {}", end.cycles - 1));
   }
   return okStatus();
 }
 
 }  // namespace
-
-std::string_view toString(Compare c) {
-  switch (c) {
-    case Compare::kEq:
-      return "==";
-    case Compare::kNe:
-      return "!=";
-    case Compare::kLt:
-      return "<";
-    case Compare::kLe:
-      return "<=";
-    case Compare::kGt:
-      return ">";
-    case Compare::kGe:
-      return ">=";
-  }
-  return "?";
-}
-
-bool compareValues(double observed, Compare c, double expected, double tolerance) {
-  switch (c) {
-    case Compare::kEq:
-      return std::fabs(observed - expected) <= tolerance;
-    case Compare::kNe:
-      return std::fabs(observed - expected) > tolerance;
-    case Compare::kLt:
-      return observed < expected;
-    case Compare::kLe:
-      return observed <= expected;
-    case Compare::kGt:
-      return observed > expected;
-    case Compare::kGe:
-      return observed >= expected;
-  }
-  return false;
-}
 
 Result<Scenario> loadScenario(const std::filesystem::path& path) {
   ECSIM_ASSIGN_OR_RETURN(const std::string text, readRegularFile(path, kMaxXmlFileBytes));
@@ -447,28 +464,6 @@ Result<Scenario> loadScenario(const std::filesystem::path& path) {
   }
   ECSIM_TRY(checkTopologyNames(s, *topology));
   return s;
-}
-
-Status checkTopologyNames(const Scenario& s, const TopologyConfig& topology) {
-  std::vector<std::string_view> slaves;
-  for (const auto& slave : topology.slaves) slaves.push_back(slave.name);
-  std::vector<std::string_view> cables{"master"};
-  for (const auto& link : topology.links) cables.push_back(link.name);
-  auto check = [&](int line, std::string_view what, std::string_view name,
-                   const std::vector<std::string_view>& names) -> Status {
-    if (std::find(names.begin(), names.end(), name) != names.end()) return okStatus();
-    return makeError(ErrorCode::kParse,
-                     fmt::format("{}, line {}: no {} '{}' in the topology{}", s.file.string(), line,
-                                 what, name, didYouMean(name, names)));
-  };
-  for (const auto& a : s.actions) {
-    if (auto slave = a.action.get("slave")) ECSIM_TRY(check(a.line, "slave", *slave, slaves));
-    if (auto cable = a.action.get("cable")) ECSIM_TRY(check(a.line, "cable", *cable, cables));
-  }
-  for (const auto& x : s.expectations) {
-    if (!x.slave.empty()) ECSIM_TRY(check(x.line, "slave", x.slave, slaves));
-  }
-  return okStatus();
 }
 
 Result<Scenario> parseScenario(std::string_view xml, const std::filesystem::path& path) {
@@ -529,7 +524,8 @@ Result<Scenario> parseScenario(std::string_view xml, const std::filesystem::path
       if (std::string_view(e->Name()) != "Action") {
         return r.error(e, "the Timeline holds <Action> elements only");
       }
-      ECSIM_ASSIGN_OR_RETURN(auto a, readAction(r, e));
+      ECSIM_ASSIGN_OR_RETURN(
+          auto a, readAction(r, e, s.masterKind == "external" ? SimTime{0} : s.cycleTime));
       ECSIM_TRY(checkWithinRun(r, e, s, a));
       s.actions.push_back(std::move(a));
     }
@@ -537,7 +533,8 @@ Result<Scenario> parseScenario(std::string_view xml, const std::filesystem::path
   if (const auto* x = root->FirstChildElement("Expect")) {
     ECSIM_TRY(xml::checkNames(r.context(), x, kExpectNames));
     for (const auto* e = x->FirstChildElement(); e != nullptr; e = e->NextSiblingElement()) {
-      ECSIM_ASSIGN_OR_RETURN(auto exp, readExpectation(r, e));
+      ECSIM_ASSIGN_OR_RETURN(
+          auto exp, readExpectation(r, e, s.masterKind == "external" ? SimTime{0} : s.cycleTime));
       ECSIM_TRY(checkWithinRun(r, e, s, exp));
       s.expectations.push_back(std::move(exp));
     }
@@ -545,42 +542,6 @@ Result<Scenario> parseScenario(std::string_view xml, const std::filesystem::path
   if (s.expectations.empty()) return r.error(root, "a scenario needs at least one expectation");
   ECSIM_TRY(checkMasterKind(s));
   return s;
-}
-
-Status checkMasterKind(const Scenario& s) {
-  const bool external = s.masterKind == "external";
-  auto refuse = [&](int line, const std::string& what) -> Status {
-    return makeError(ErrorCode::kParse,
-                     s.file.string() + ", line " + std::to_string(line) + ": " + what);
-  };
-  for (const auto& a : s.actions) {
-    if (external && a.action.verb == "pause-master") {
-      return refuse(a.line,
-                    "pause-master needs our master: an external master sends what it sends");
-    }
-  }
-  for (const auto& x : s.expectations) {
-    const char* inner = x.kind == ExpectKind::kDetected     ? "Detected"
-                        : x.kind == ExpectKind::kStatistic  ? "Statistic"
-                        : x.kind == ExpectKind::kVariable   ? "Variable"
-                        : x.kind == ExpectKind::kContinuity ? "Continuity"
-                                                            : nullptr;
-    if (external && inner != nullptr) {
-      return refuse(x.line, std::string(inner) +
-                                " looks inside the master, which an external master does not "
-                                "show: judge it by State, Register, BackInOp, ExitStatus or "
-                                "Output");
-    }
-    const bool commandOnly = x.kind == ExpectKind::kExitStatus || x.kind == ExpectKind::kOutput;
-    if (!external && commandOnly) {
-      return refuse(x.line, std::string(x.kind == ExpectKind::kOutput ? "Output" : "ExitStatus") +
-                                " judges an external master's command (Master kind=\"external\")");
-    }
-    if (!external && x.afterTime) {
-      return refuse(x.line, "BackInOp afterMs is for external masters; ours counts afterCycle");
-    }
-  }
-  return okStatus();
 }
 
 }  // namespace ecsim::scenario

@@ -11,6 +11,8 @@
 #include <cerrno>
 #include <cstring>
 
+#include "topology/faults.hpp"
+
 namespace ecsim::topology {
 namespace {
 
@@ -167,6 +169,13 @@ void ControlServer::takeLines(Client& c, std::string_view data, const Handler& h
     c.reply += handler(c.buffer) + "\n";
     c.buffer.clear();
   }
+}
+
+std::string answerFaultLine(FaultInjector& faults, std::string_view line, SimTime now) {
+  auto fault = parseFaultLine(line);
+  if (!fault.ok()) return "error " + fault.error().context;
+  auto done = faults.apply(*fault, now, "control");
+  return done.ok() ? "ok " + *done : "error " + done.error().context;
 }
 
 std::filesystem::path controlSocketDir() {

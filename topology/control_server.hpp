@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "link/fd.hpp"
@@ -74,6 +75,11 @@ class ControlServer {
   ControlLimits limits_;
   std::vector<Client> clients_;
 };
+
+class FaultInjector;
+// The answer to one control line: parsed into a typed fault (parseFaultLine: every argument
+// checked) and applied at `now`: "ok <what was done>" or "error control: <why>".
+std::string answerFaultLine(FaultInjector& faults, std::string_view line, SimTime now);
 
 // Where `ecsim serve` puts its control socket unless told otherwise, and `ecsim ctl` looks for
 // it: /run/ecsim/<interface>.sock.

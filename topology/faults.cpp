@@ -4,67 +4,21 @@
 
 #include <algorithm>
 #include <array>
-#include <charconv>
 
 #include "protocol/al_status.hpp"
 #include "protocol/closest_name.hpp"
 #include "protocol/mailbox.hpp"
 #include "protocol/sdo.hpp"
 #include "slavesim/devices/device_models.hpp"
-#include "slavesim/devices/signal.hpp"
 #include "slavesim/process_data.hpp"
 
 namespace ecsim::topology {
 namespace {
 
 constexpr std::size_t kSiiChecksumByte = 14;  // word 7, low byte: CRC-8 of words 0-6
-constexpr std::uint16_t kOvercurrent = 0x2310;
 constexpr std::uint16_t kPositionSensorFault = 0x7305;
 
-// ---- The verbs and the arguments each takes (checkFaultArguments) --------------------------
-// Keys in alphabetical order; a verb has at most kMaxVerbKeys.
-constexpr std::size_t kMaxVerbKeys = 5;
-struct VerbArguments {
-  std::string_view verb;
-  std::array<std::string_view, kMaxVerbKeys> keys;
-};
-constexpr std::array<VerbArguments, 18> kVerbArguments{{
-    {"loss", {"cable", "rate"}},
-    {"corrupt", {"cable", "count", "port", "slave"}},
-    {"delay", {"cable", "durationMs", "ns", "port", "slave"}},
-    {"link-down", {"cable", "port", "slave"}},
-    {"link-up", {"cable", "port", "slave"}},
-    {"power-off", {"slave"}},
-    {"power-on", {"slave"}},
-    {"power-cycle", {"slave"}},
-    {"al-error", {"code", "slave", "state"}},
-    {"eeprom-checksum", {"slave"}},
-    {"mailbox-silent", {"on", "slave"}},
-    {"mailbox-ok", {"on", "slave"}},
-    {"sdo-abort", {"code", "index", "slave", "sub"}},
-    {"sdo-ok", {"slave"}},
-    {"drive-fault", {"code", "slave"}},
-    {"encoder-fault", {"channel", "kind", "on", "slave"}},
-    {"input", {"channel", "signal", "slave"}},
-    {"latch", {"level", "slave", "unit"}},
-}};
 
-const VerbArguments* verbArguments(std::string_view verb) {
-  for (const auto& v : kVerbArguments) {
-    if (v.verb == verb) return &v;
-  }
-  return nullptr;
-}
-// ---- end of the verb table ------------------------------------------------------------------
-
-std::optional<AlState> stateFromName(std::string_view name) {
-  if (name == "INIT") return AlState::kInit;
-  if (name == "PREOP") return AlState::kPreOp;
-  if (name == "BOOT") return AlState::kBootstrap;
-  if (name == "SAFEOP") return AlState::kSafeOp;
-  if (name == "OP") return AlState::kOp;
-  return std::nullopt;
-}
 
 // Wraps a slave's mailbox server: silent (requests swallowed, nothing answered) or aborting
 // SDO requests for chosen objects with a chosen code; everything else goes to the real server.
@@ -133,185 +87,11 @@ FaultyMailbox& faultyMailbox(slavesim::Slave& slave) {
   return ref;
 }
 
-// An encoder terminal's fault (slavesim/devices/encoder_terminal.hpp): kind=data (default),
-// frame or power, on=0 clears, channel=N (default 1).
-Result<std::string> encoderFault(const FaultAction& a, slavesim::Slave& slave) {
-  auto& encoder = *slavesim::devices::encoderTerminalOf(slave);
-  ECSIM_ASSIGN_OR_RETURN(auto channel, a.number("channel", 1, encoder.channels(), 1));
-  ECSIM_ASSIGN_OR_RETURN(auto on, a.number("on", 0, 1, 1));
-  namespace ef = slavesim::devices::encoder_fault;
-  const std::string_view kind = a.get("kind").value_or("data");
-  std::uint8_t bit = ef::kData;
-  if (kind == "frame") {
-    bit = ef::kFrame;
-  } else if (kind == "power") {
-    bit = ef::kPower;
-  } else if (kind != "data") {
-    return a.error("kind must be data, frame or power" +
-                   didYouMean(kind, {"data", "frame", "power"}));
-  }
-  const auto ch = static_cast<unsigned>(channel);
-  const std::uint8_t faults = on != 0 ? static_cast<std::uint8_t>(encoder.fault(ch) | bit)
-                                      : static_cast<std::uint8_t>(encoder.fault(ch) & ~bit);
-  encoder.setFault(ch, faults);
-  return fmt::format("{}: encoder channel {} {} {}", slave.name(), ch, kind,
-                     on != 0 ? "fault" : "fault cleared");
+Error fail(std::string message) {
+  return makeError(ErrorCode::kInvalidArgument, std::move(message));
 }
 
 }  // namespace
-
-// ---- FaultAction ----------------------------------------------------------------------------
-
-std::optional<std::uint64_t> parseNumber(std::string_view text) {
-  int base = 10;
-  if (text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X')) {
-    text.remove_prefix(2);
-    base = 16;
-  }
-  std::uint64_t v = 0;
-  auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v, base);
-  if (ec != std::errc() || end != text.data() + text.size() || text.empty()) return std::nullopt;
-  return v;
-}
-
-std::optional<std::string_view> FaultAction::get(std::string_view key) const {
-  auto it = args.find(key);
-  if (it == args.end()) return std::nullopt;
-  return std::string_view(it->second);
-}
-
-Error FaultAction::error(std::string_view message) const {
-  return makeError(ErrorCode::kInvalidArgument, (where.empty() ? std::string() : where + ": ") +
-                                                    verb + ": " + std::string(message));
-}
-
-Result<std::string_view> FaultAction::require(std::string_view key) const {
-  if (auto v = get(key)) return *v;
-  return error("missing argument '" + std::string(key) + "'");
-}
-
-Result<std::uint64_t> FaultAction::number(std::string_view key, std::uint64_t lo,
-                                          std::uint64_t hi) const {
-  ECSIM_ASSIGN_OR_RETURN(auto text, require(key));
-  auto v = parseNumber(text);
-  if (v && *v >= lo && *v <= hi) return *v;
-  const bool hex = text.size() > 1 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X');
-  const auto bound = [hex](std::uint64_t b) {
-    return hex && b != 0 ? fmt::format("{:#x}", b) : fmt::format("{}", b);
-  };
-  return error(fmt::format("{}={} is not a number in [{}, {}]", key, text, bound(lo), bound(hi)));
-}
-
-Result<std::uint64_t> FaultAction::number(std::string_view key, std::uint64_t lo, std::uint64_t hi,
-                                          std::uint64_t fallback) const {
-  if (!get(key)) return fallback;
-  return number(key, lo, hi);
-}
-
-Result<double> FaultAction::real(std::string_view key, double lo, double hi) const {
-  ECSIM_ASSIGN_OR_RETURN(auto text, require(key));
-  double v = 0;
-  auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-  // NaN fails both comparisons: written so that it is refused.
-  if (ec == std::errc() && end == text.data() + text.size() && v >= lo && v <= hi) return v;
-  return error(fmt::format("{}={} is not a number in [{}, {}]", key, text, lo, hi));
-}
-
-Result<SimTime> FaultAction::millis(std::string_view key) const {
-  ECSIM_ASSIGN_OR_RETURN(auto ms, real(key, 0, static_cast<double>(kMaxFaultDurationMs)));
-  return saturatingTime(ms * static_cast<double>(kNsPerMs));
-}
-
-std::string FaultAction::text() const {
-  std::string out = verb;
-  for (const auto& [k, v] : args) {
-    const bool quote = v.find(' ') != std::string::npos || v.empty();
-    out += " " + k + "=" + (quote ? "\"" + v + "\"" : v);
-  }
-  return out;
-}
-
-std::vector<std::string_view> faultVerbs() {
-  std::vector<std::string_view> verbs;
-  for (const auto& v : kVerbArguments) verbs.push_back(v.verb);
-  return verbs;
-}
-
-std::vector<std::string_view> faultArguments(std::string_view verb) {
-  std::vector<std::string_view> keys;
-  if (const VerbArguments* v = verbArguments(verb)) {
-    for (std::string_view k : v->keys) {
-      if (!k.empty()) keys.push_back(k);
-    }
-  }
-  return keys;
-}
-
-Status checkFaultArguments(const FaultAction& action) {
-  if (verbArguments(action.verb) == nullptr) {
-    return makeError(ErrorCode::kInvalidArgument,
-                     (action.where.empty() ? std::string() : action.where + ": ") +
-                         unknownNameText("action", action.verb, faultVerbs()));
-  }
-  const std::vector<std::string_view> keys = faultArguments(action.verb);
-  for (const auto& [key, value] : action.args) {
-    if (std::find(keys.begin(), keys.end(), key) == keys.end()) {
-      return action.error(unknownNameText("argument", key, keys));
-    }
-  }
-  return okStatus();
-}
-
-Result<FaultAction> parseFaultAction(std::string_view line) {
-  auto fail = [](std::size_t at, const std::string& what) {
-    return makeError(ErrorCode::kParse, fmt::format("control: column {}: {}", at + 1, what));
-  };
-  if (!line.empty() && line.back() == '\r') line.remove_suffix(1);  // CR LF (nc -C, telnet)
-  for (std::size_t k = 0; k < line.size(); ++k) {
-    const auto c = static_cast<unsigned char>(line[k]);
-    if ((c < 0x20 && c != '\t') || c == 0x7F) {
-      return fail(k, fmt::format("byte {:#04x} is not printable", c));
-    }
-  }
-  const auto isSpace = [](char c) { return c == ' ' || c == '\t'; };
-  FaultAction action;
-  action.where = "control";
-  std::size_t i = 0;
-  auto skipSpace = [&] {
-    while (i < line.size() && isSpace(line[i])) ++i;
-  };
-  skipSpace();
-  std::size_t start = i;
-  while (i < line.size() && !isSpace(line[i])) ++i;
-  action.verb = std::string(line.substr(start, i - start));
-  if (action.verb.empty()) return makeError(ErrorCode::kParse, "control: empty action");
-  while (true) {
-    skipSpace();
-    if (i >= line.size()) break;
-    start = i;
-    while (i < line.size() && line[i] != '=' && !isSpace(line[i])) ++i;
-    if (i >= line.size() || line[i] != '=') return fail(start, "expected key=value");
-    if (i == start) return fail(start, "empty argument name");
-    std::string key(line.substr(start, i - start));
-    ++i;
-    std::string value;
-    if (i < line.size() && line[i] == '"') {
-      const std::size_t close = line.find('"', i + 1);
-      if (close == std::string_view::npos) return fail(i, "unterminated quote");
-      value = std::string(line.substr(i + 1, close - i - 1));
-      i = close + 1;
-    } else {
-      const std::size_t from = i;
-      while (i < line.size() && !isSpace(line[i])) ++i;
-      value = std::string(line.substr(from, i - from));
-    }
-    if (!action.args.emplace(key, std::move(value)).second) {
-      return fail(start, "argument '" + key + "' given twice");
-    }
-  }
-  ECSIM_TRY(checkFaultArguments(action));
-  return action;
-}
 
 // ---- FaultInjector --------------------------------------------------------------------------
 
@@ -325,7 +105,8 @@ FaultInjector::~FaultInjector() {
 }
 
 bool FaultInjector::handles(std::string_view verb) {
-  return verbArguments(verb) != nullptr;
+  const auto verbs = faultVerbs(FaultScope::kControl);
+  return std::find(verbs.begin(), verbs.end(), verb) != verbs.end();
 }
 
 Result<std::size_t> FaultInjector::slaveIndex(std::string_view name) const {
@@ -344,23 +125,24 @@ std::optional<FaultInjector::End> FaultInjector::peer(End end) const {
   return End{static_cast<std::size_t>(l.slave), l.port};
 }
 
-Result<FaultInjector::End> FaultInjector::cableEnd(const FaultAction& action) const {
-  if (auto name = action.get("cable")) {
-    const CableRef* c = network_.findCable(*name);
+Result<std::size_t> FaultInjector::slaveNamed(std::string_view name) const {
+  auto s = slaveIndex(name);
+  if (!s.ok()) return fail(s.error().context);
+  return *s;
+}
+
+Result<FaultInjector::End> FaultInjector::cableEnd(const FaultPlace& at) const {
+  if (!at.cable.empty()) {
+    const CableRef* c = network_.findCable(at.cable);
     if (c == nullptr) {
       std::vector<std::string_view> names;
       for (const auto& cable : network_.cables) names.push_back(cable.name);
-      return action.error("no cable named '" + std::string(*name) + "'" + didYouMean(*name, names));
+      return fail("no cable named '" + at.cable + "'" + didYouMean(at.cable, names));
     }
     return End{c->slave, c->port};
   }
-  if (auto slave = action.get("slave")) {
-    auto s = slaveIndex(*slave);
-    if (!s.ok()) return action.error(s.error().context);
-    ECSIM_ASSIGN_OR_RETURN(auto port, action.number("port", 0, kPortCount - 1));
-    return End{*s, static_cast<unsigned>(port)};
-  }
-  return action.error("needs cable=NAME or slave=NAME port=N");
+  ECSIM_ASSIGN_OR_RETURN(auto s, slaveNamed(at.slave));
+  return End{s, at.port};
 }
 
 void FaultInjector::setCable(End end, bool up) {
@@ -440,204 +222,227 @@ Result<std::string> FaultInjector::powerOn(std::size_t s, SimTime now) {
          (running ? std::string() : std::string(" (EEPROM not loaded: PDI not operational)"));
 }
 
-Result<std::string> FaultInjector::apply(const FaultAction& a, SimTime now) {
-  const std::string& v = a.verb;
-  if (v == "loss") {
-    ECSIM_ASSIGN_OR_RETURN(auto rate, a.real("rate", 0, 1));
-    End end{0, 0};
-    if (a.get("cable")) {
-      ECSIM_ASSIGN_OR_RETURN(end, cableEnd(a));
-    }
-    if (rate == 0)
-      lossRate_.erase(end);
-    else
-      lossRate_[end] = rate;
+Result<std::string> FaultInjector::apply(const Fault& fault, SimTime now, std::string_view where) {
+  auto done = std::visit([&](const auto& f) { return on(f, now); }, fault);
+  if (done.ok()) return done;
+  return makeError(done.error().code, (where.empty() ? std::string() : std::string(where) + ": ") +
+                                          std::string(verbOf(fault)) + ": " +
+                                          done.error().context);
+}
+
+Result<std::string> FaultInjector::on(const Loss& f, SimTime /*now*/) {
+  End end{0, 0};  // the master's cable
+  if (!f.cable.empty()) {
+    ECSIM_ASSIGN_OR_RETURN(end, cableEnd(FaultPlace{f.cable, {}, 0}));
+  }
+  if (f.rate == 0)
+    lossRate_.erase(end);
+  else
+    lossRate_[end] = f.rate;
+  refreshAny();
+  return fmt::format("frame loss {:.4f} at slave {} port {}", f.rate, end.slave, end.port);
+}
+
+Result<std::string> FaultInjector::on(const Corrupt& f, SimTime /*now*/) {
+  ECSIM_ASSIGN_OR_RETURN(auto end, cableEnd(f.at));
+  if (f.count == 0) {
+    corruptCount_.erase(end);
     refreshAny();
-    return fmt::format("frame loss {:.4f} at slave {} port {}", rate, end.slave, end.port);
+    return fmt::format("corruption entering {} port {} cleared", segment_.slave(end.slave).name(),
+                       end.port);
   }
-  if (v == "corrupt") {
-    ECSIM_ASSIGN_OR_RETURN(auto end, cableEnd(a));
-    ECSIM_ASSIGN_OR_RETURN(auto count, a.number("count", 0, kMaxCorruptCount, 1));
-    if (count == 0) {
-      corruptCount_.erase(end);
-      refreshAny();
-      return fmt::format("corruption entering {} port {} cleared", segment_.slave(end.slave).name(),
-                         end.port);
-    }
-    auto& pending = corruptCount_[end];
-    pending = std::min(pending + count, kMaxCorruptCount);
-    refreshAny();
-    return fmt::format("{} frame(s) corrupted entering {} port {}", pending,
-                       segment_.slave(end.slave).name(), end.port);
+  auto& pending = corruptCount_[end];
+  pending = std::min(pending + f.count, kMaxCorruptCount);
+  refreshAny();
+  return fmt::format("{} frame(s) corrupted entering {} port {}", pending,
+                     segment_.slave(end.slave).name(), end.port);
+}
+
+Result<std::string> FaultInjector::on(const Delay& f, SimTime now) {
+  ECSIM_ASSIGN_OR_RETURN(auto end, cableEnd(f.at));
+  const std::optional<End> other = peer(end);
+  const auto sameCable = [&](const Spike& s) { return s.end == end || (other && s.end == *other); };
+  spikes_.erase(std::remove_if(spikes_.begin(), spikes_.end(),
+                               [&](const Spike& s) {
+                                 return s.until <= now || (f.extra == 0 && sameCable(s));
+                               }),
+                spikes_.end());
+  refreshAny();
+  if (f.extra == 0) return std::string("delay spikes on the cable removed");
+  if (f.duration == 0) return std::string("no delay: duration 0");
+  if (spikes_.size() >= kMaxDelaySpikes) {
+    return fail(fmt::format(
+        "{} delay spikes are active, the most at once (ns=0 removes a cable's spikes)",
+        spikes_.size()));
   }
-  if (v == "delay") {
-    ECSIM_ASSIGN_OR_RETURN(auto end, cableEnd(a));
-    ECSIM_ASSIGN_OR_RETURN(auto ns, a.number("ns", 0, kMaxDelaySpikeNs));
-    ECSIM_ASSIGN_OR_RETURN(auto duration, a.millis("durationMs"));
-    const std::optional<End> other = peer(end);
-    const auto sameCable = [&](const Spike& s) {
-      return s.end == end || (other && s.end == *other);
-    };
-    spikes_.erase(
-        std::remove_if(spikes_.begin(), spikes_.end(),
-                       [&](const Spike& s) { return s.until <= now || (ns == 0 && sameCable(s)); }),
-        spikes_.end());
-    refreshAny();
-    if (ns == 0) return std::string("delay spikes on the cable removed");
-    if (duration == 0) return std::string("no delay: durationMs=0");
-    if (spikes_.size() >= kMaxDelaySpikes) {
-      return a.error(
-          fmt::format("{} delay spikes are active, the most at once (ns=0 removes a "
-                      "cable's spikes)",
-                      spikes_.size()));
-    }
-    spikes_.push_back({end, static_cast<SimTime>(ns), saturatingAdd(now, duration)});
-    refreshAny();
-    return fmt::format("cable delay +{} ns for {} ms", ns, a.get("durationMs").value_or(""));
+  spikes_.push_back({end, f.extra, saturatingAdd(now, f.duration)});
+  refreshAny();
+  return fmt::format("cable delay +{} ns for {} ms", f.extra,
+                     static_cast<double>(f.duration) / static_cast<double>(kNsPerMs));
+}
+
+Result<std::string> FaultInjector::setLink(const FaultPlace& at, bool up) {
+  ECSIM_ASSIGN_OR_RETURN(auto end, cableEnd(at));
+  if (up) {
+    cablesDown_.erase(end);
+    if (auto p = peer(end)) cablesDown_.erase(*p);
+  } else {
+    cablesDown_.insert(end);
   }
-  if (v == "link-down" || v == "link-up") {
-    ECSIM_ASSIGN_OR_RETURN(auto end, cableEnd(a));
-    const bool up = v == "link-up";
-    if (up) {
-      cablesDown_.erase(end);
-      if (auto p = peer(end)) cablesDown_.erase(*p);
-    } else {
-      cablesDown_.insert(end);
-    }
-    setCable(end, up);
-    return fmt::format("link {} at {} port {}", up ? "up" : "down",
-                       segment_.slave(end.slave).name(), end.port);
-  }
-  if (v == "input") {
-    ECSIM_ASSIGN_OR_RETURN(auto name, a.require("slave"));
-    auto s = slaveIndex(name);
-    if (!s.ok()) return a.error(s.error().context);
-    ECSIM_ASSIGN_OR_RETURN(auto text, a.require("signal"));
-    auto signal = slavesim::devices::parseSignal(text);
-    if (!signal.ok()) return a.error(signal.error().context);
-    auto& slave = segment_.slave(*s);
-    auto* di = slavesim::devices::digitalInputsOf(slave);
-    auto* ai = slavesim::devices::analogInputsOf(slave);
-    auto* enc = slavesim::devices::encoderTerminalOf(slave);
-    const unsigned channels = di != nullptr    ? di->channels()
-                              : ai != nullptr  ? ai->channels()
-                              : enc != nullptr ? enc->channels()
-                                               : 0;
-    if (channels == 0) return a.error(slave.name() + " has no scriptable inputs");
-    ECSIM_ASSIGN_OR_RETURN(auto ch, a.number("channel", 1, channels));
-    const auto channel = static_cast<unsigned>(ch);
-    // The script's time starts now: a square wave set at cycle 0 is high for its first half
-    // period however long the bring-up before cycle 0 took.
-    const auto script = signal->startingAt(now);
-    if (di != nullptr) {
-      di->setScript(channel, script);
-    } else if (ai != nullptr) {
-      ai->setScript(channel, script);
-    } else {
-      enc->setScript(channel, script);  // shaft position in turns
-    }
-    return fmt::format("{} input {} = {}", slave.name(), channel, text);
-  }
-  // The remaining verbs address one slave.
-  ECSIM_ASSIGN_OR_RETURN(auto name, a.require("slave"));
-  auto index = slaveIndex(name);
-  if (!index.ok()) return a.error(index.error().context);
-  const std::size_t s = *index;
+  setCable(end, up);
+  return fmt::format("link {} at {} port {}", up ? "up" : "down",
+                     segment_.slave(end.slave).name(), end.port);
+}
+
+Result<std::string> FaultInjector::on(const LinkDown& f, SimTime /*now*/) {
+  return setLink(f.at, false);
+}
+
+Result<std::string> FaultInjector::on(const LinkUp& f, SimTime /*now*/) {
+  return setLink(f.at, true);
+}
+
+Result<std::string> FaultInjector::on(const Input& f, SimTime now) {
+  ECSIM_ASSIGN_OR_RETURN(auto s, slaveNamed(f.slave));
   auto& slave = segment_.slave(s);
-  if (v == "power-off") return powerOff(s);
-  if (v == "power-on") return powerOn(s, now);
-  if (v == "power-cycle") {
-    if (auto off = powerOff(s); !off.ok()) return off.takeError();
-    return powerOn(s, now);
+  auto* di = slavesim::devices::digitalInputsOf(slave);
+  auto* ai = slavesim::devices::analogInputsOf(slave);
+  auto* enc = slavesim::devices::encoderTerminalOf(slave);
+  const unsigned channels = di != nullptr    ? di->channels()
+                            : ai != nullptr  ? ai->channels()
+                            : enc != nullptr ? enc->channels()
+                                             : 0;
+  if (channels == 0) return fail(slave.name() + " has no scriptable inputs");
+  if (f.channel < 1 || f.channel > channels) {
+    return fail(fmt::format("channel={} is not a number in [1, {}] ({}'s channels)", f.channel,
+                            channels, slave.name()));
   }
-  if (v == "al-error") {
-    ECSIM_ASSIGN_OR_RETURN(auto code, a.number("code", 0, 0xFFFF));
-    AlState target = std::min(slave.state(), AlState::kSafeOp);
-    if (auto st = a.get("state")) {
-      auto parsed = stateFromName(*st);
-      if (!parsed) {
-        return a.error("state must be INIT, PREOP, SAFEOP or OP" +
-                       didYouMean(*st, {"INIT", "PREOP", "SAFEOP", "OP"}));
-      }
-      target = *parsed;
+  // The script's time starts now: a square wave set at cycle 0 is high for its first half
+  // period however long the bring-up before cycle 0 took.
+  const auto script = f.signal.startingAt(now);
+  if (di != nullptr) {
+    di->setScript(f.channel, script);
+  } else if (ai != nullptr) {
+    ai->setScript(f.channel, script);
+  } else {
+    enc->setScript(f.channel, script);  // shaft position in turns
+  }
+  return fmt::format("{} input {} = {}", slave.name(), f.channel, f.text);
+}
+
+Result<std::string> FaultInjector::on(const PowerOff& f, SimTime /*now*/) {
+  ECSIM_ASSIGN_OR_RETURN(auto s, slaveNamed(f.slave));
+  return powerOff(s);
+}
+
+Result<std::string> FaultInjector::on(const PowerOn& f, SimTime now) {
+  ECSIM_ASSIGN_OR_RETURN(auto s, slaveNamed(f.slave));
+  return powerOn(s, now);
+}
+
+Result<std::string> FaultInjector::on(const PowerCycle& f, SimTime now) {
+  ECSIM_ASSIGN_OR_RETURN(auto s, slaveNamed(f.slave));
+  if (auto off = powerOff(s); !off.ok()) return off.takeError();
+  return powerOn(s, now);
+}
+
+Result<std::string> FaultInjector::on(const AlError& f, SimTime /*now*/) {
+  ECSIM_ASSIGN_OR_RETURN(auto s, slaveNamed(f.slave));
+  auto& slave = segment_.slave(s);
+  const AlState target = f.state.value_or(std::min(slave.state(), AlState::kSafeOp));
+  slave.stateMachine().raiseError(slave.esc(), target, f.code);
+  return fmt::format("{}: AL error {:#06x} ({}), now {}+ERR", slave.name(), f.code,
+                     alStatusCodeText(f.code), toString(target));
+}
+
+Result<std::string> FaultInjector::on(const EepromChecksum& f, SimTime now) {
+  ECSIM_ASSIGN_OR_RETURN(auto s, slaveNamed(f.slave));
+  auto& esc = segment_.slave(s).esc();
+  if (esc.sii().size() <= kSiiChecksumByte) return fail("the slave has no EEPROM");
+  esc.writeSiiByte(kSiiChecksumByte, static_cast<std::uint8_t>(esc.sii()[kSiiChecksumByte] ^ 0x5A));
+  if (auto off = powerOff(s); !off.ok()) return off.takeError();
+  return powerOn(s, now);
+}
+
+Result<std::string> FaultInjector::on(const MailboxSilent& f, SimTime /*now*/) {
+  ECSIM_ASSIGN_OR_RETURN(auto s, slaveNamed(f.slave));
+  auto& slave = segment_.slave(s);
+  if (slave.mailboxServer() == nullptr) return fail(slave.name() + " has no mailbox");
+  faultyMailbox(slave).silent = f.silent;
+  return fmt::format("{}: mailbox {}", slave.name(), f.silent ? "silent" : "answering");
+}
+
+Result<std::string> FaultInjector::on(const SdoAbortFault& f, SimTime /*now*/) {
+  ECSIM_ASSIGN_OR_RETURN(auto s, slaveNamed(f.slave));
+  auto& slave = segment_.slave(s);
+  if (slave.mailboxServer() == nullptr) return fail(slave.name() + " has no mailbox");
+  auto& mbx = faultyMailbox(slave);
+  // One rule per object: a new code replaces the old (the list stays as long as the objects
+  // named, at most 65,536 x 257).
+  std::erase_if(mbx.aborts, [&](const FaultyMailbox::Rule& r) {
+    return r.index == f.index && r.subindex == f.subindex;
+  });
+  mbx.aborts.push_back({f.index, f.subindex, f.code});
+  return fmt::format("{}: SDO {:#06x} aborted with {:#010x} ({})", slave.name(), f.index, f.code,
+                     sdoAbortText(f.code));
+}
+
+Result<std::string> FaultInjector::on(const SdoOk& f, SimTime /*now*/) {
+  ECSIM_ASSIGN_OR_RETURN(auto s, slaveNamed(f.slave));
+  auto& slave = segment_.slave(s);
+  if (slave.mailboxServer() == nullptr) return fail(slave.name() + " has no mailbox");
+  faultyMailbox(slave).aborts.clear();
+  return slave.name() + ": SDO aborts removed";
+}
+
+Result<std::string> FaultInjector::on(const Latch& f, SimTime now) {
+  ECSIM_ASSIGN_OR_RETURN(auto s, slaveNamed(f.slave));
+  auto& slave = segment_.slave(s);
+  if (slave.esc().dcUnit() != slavesim::Esc::DcUnit::kFull) {
+    return fail(slave.name() + "'s ESC has no DC latch unit");
+  }
+  // The edge (if the level changes) at the action's time (esc_latch.cpp).
+  slave.setLatchSignal(f.unit, f.level, now);
+  return fmt::format("{}: LATCH{} = {}", slave.name(), f.unit, f.level ? 1 : 0);
+}
+
+Result<std::string> FaultInjector::on(const DriveFault& f, SimTime /*now*/) {
+  ECSIM_ASSIGN_OR_RETURN(auto s, slaveNamed(f.slave));
+  auto& slave = segment_.slave(s);
+  auto* drive = slavesim::devices::driveOf(slave);
+  if (drive == nullptr) return fail(slave.name() + " is not a CiA 402 drive");
+  drive->injectFault(f.code);
+  return fmt::format("{}: drive fault {:#06x}", slave.name(), f.code);
+}
+
+// On an encoder terminal (slavesim/devices/encoder_terminal.hpp) the channel's status bits; on
+// a CiA 402 drive its position sensor fault.
+Result<std::string> FaultInjector::on(const EncoderFault& f, SimTime /*now*/) {
+  ECSIM_ASSIGN_OR_RETURN(auto s, slaveNamed(f.slave));
+  auto& slave = segment_.slave(s);
+  if (auto* encoder = slavesim::devices::encoderTerminalOf(slave)) {
+    if (f.channel > encoder->channels()) {
+      return fail(fmt::format("channel={} is not a number in [1, {}] ({}'s channels)", f.channel,
+                              encoder->channels(), slave.name()));
     }
-    slave.stateMachine().raiseError(slave.esc(), target, static_cast<std::uint16_t>(code));
-    return fmt::format("{}: AL error {:#06x} ({}), now {}+ERR", slave.name(), code,
-                       alStatusCodeText(static_cast<std::uint16_t>(code)), toString(target));
+    namespace ef = slavesim::devices::encoder_fault;
+    const std::uint8_t bit = f.kind == EncoderFault::Kind::kFrame   ? ef::kFrame
+                             : f.kind == EncoderFault::Kind::kPower ? ef::kPower
+                                                                    : ef::kData;
+    const std::uint8_t old = encoder->fault(f.channel);
+    encoder->setFault(f.channel, f.on ? static_cast<std::uint8_t>(old | bit)
+                                      : static_cast<std::uint8_t>(old & ~bit));
+    return fmt::format("{}: encoder channel {} {} {}", slave.name(), f.channel, toString(f.kind),
+                       f.on ? "fault" : "fault cleared");
   }
-  if (v == "eeprom-checksum") {
-    auto& esc = slave.esc();
-    if (esc.sii().size() <= kSiiChecksumByte) return a.error("the slave has no EEPROM");
-    esc.writeSiiByte(kSiiChecksumByte,
-                     static_cast<std::uint8_t>(esc.sii()[kSiiChecksumByte] ^ 0x5A));
-    if (auto off = powerOff(s); !off.ok()) return off.takeError();
-    return powerOn(s, now);
-  }
-  if (v == "mailbox-silent" || v == "mailbox-ok") {
-    ECSIM_ASSIGN_OR_RETURN(auto on, a.number("on", 0, 1, v == "mailbox-silent" ? 1 : 0));
-    if (slave.mailboxServer() == nullptr) return a.error(slave.name() + " has no mailbox");
-    faultyMailbox(slave).silent = on != 0;
-    return fmt::format("{}: mailbox {}", slave.name(), on != 0 ? "silent" : "answering");
-  }
-  if (v == "sdo-abort" || v == "sdo-ok") {
-    FaultyMailbox::Rule rule;
-    if (v == "sdo-abort") {
-      ECSIM_ASSIGN_OR_RETURN(auto objIndex, a.number("index", 0, 0xFFFF));
-      // Default: object does not exist.
-      ECSIM_ASSIGN_OR_RETURN(auto code, a.number("code", 0, 0xFFFFFFFF, 0x06020000));
-      rule.index = static_cast<std::uint16_t>(objIndex);
-      rule.code = static_cast<std::uint32_t>(code);
-      if (a.get("sub")) {
-        ECSIM_ASSIGN_OR_RETURN(auto sub, a.number("sub", 0, 0xFF));
-        rule.subindex = static_cast<std::uint8_t>(sub);
-      }
-    }
-    if (slave.mailboxServer() == nullptr) return a.error(slave.name() + " has no mailbox");
-    auto& mbx = faultyMailbox(slave);
-    if (v == "sdo-ok") {
-      mbx.aborts.clear();
-      return slave.name() + ": SDO aborts removed";
-    }
-    // One rule per object: a new code replaces the old (the list stays as long as the
-    // objects named, at most 65,536 x 257).
-    std::erase_if(mbx.aborts, [&](const FaultyMailbox::Rule& r) {
-      return r.index == rule.index && r.subindex == rule.subindex;
-    });
-    mbx.aborts.push_back(rule);
-    const auto objIndex = rule.index;
-    const auto code = rule.code;
-    return fmt::format("{}: SDO {:#06x} aborted with {:#010x} ({})", slave.name(), objIndex, code,
-                       sdoAbortText(static_cast<std::uint32_t>(code)));
-  }
-  if (v == "latch") {
-    ECSIM_ASSIGN_OR_RETURN(auto unit, a.number("unit", 0, 1));
-    ECSIM_ASSIGN_OR_RETURN(auto level, a.number("level", 0, 1));
-    if (slave.esc().dcUnit() != slavesim::Esc::DcUnit::kFull) {
-      return a.error(slave.name() + "'s ESC has no DC latch unit");
-    }
-    // The edge (if the level changes) at the action's time (esc_latch.cpp).
-    slave.setLatchSignal(static_cast<unsigned>(unit), level != 0, now);
-    return fmt::format("{}: LATCH{} = {}", slave.name(), unit, level);
-  }
-  if (v == "encoder-fault") {
-    if (slavesim::devices::encoderTerminalOf(slave) != nullptr) return encoderFault(a, slave);
-  }
-  if (v == "drive-fault" || v == "encoder-fault") {
-    std::uint16_t code = kPositionSensorFault;
-    if (v == "drive-fault") {
-      ECSIM_ASSIGN_OR_RETURN(auto c, a.number("code", 0, 0xFFFF, kOvercurrent));
-      code = static_cast<std::uint16_t>(c);
-    }
-    auto* drive = slavesim::devices::driveOf(slave);
-    if (drive == nullptr) {
-      return a.error(slave.name() + (v == "encoder-fault"
-                                         ? " is neither an encoder terminal nor a CiA 402 drive"
-                                         : " is not a CiA 402 drive"));
-    }
-    drive->injectFault(code);
-    return fmt::format("{}: drive fault {:#06x}", slave.name(), code);
-  }
-  return a.error("unknown action");
+  auto* drive = slavesim::devices::driveOf(slave);
+  if (drive == nullptr) return fail(slave.name() + " is neither an encoder terminal nor a CiA 402 drive");
+  drive->injectFault(kPositionSensorFault);
+  return fmt::format("{}: drive fault {:#06x}", slave.name(), kPositionSensorFault);
+}
+
+Result<std::string> FaultInjector::on(const PauseMaster& /*f*/, SimTime /*now*/) {
+  return fail("a scenario action of the runner's master: no network fault");
 }
 
 }  // namespace ecsim::topology

@@ -25,13 +25,22 @@
 //   latch slave=S unit=0|1 level=0|1      the ESC's DC latch input LATCH0/1 goes to the level
 //                                   now (an edge is time-stamped, slavesim/esc_latch.cpp)
 //
-// Numbers: every argument has a range and a value outside it is refused with the range in the
-// message ("loss: rate=nan is not a number in [0, 1]"); NaN, infinities and integers that do
-// not fit are refused, never truncated. rate in [0, 1]; ns in [0, kMaxDelaySpikeNs] (1 s);
-// durationMs in [0, kMaxFaultDurationMs] (one day); count in [0, kMaxCorruptCount]; codes
-// and indexes within their wire width (al-error/drive-fault code and sdo-abort index 16 bits,
-// sdo-abort code 32 bits, sub 8 bits); port 0..3; on 0..1; channel 1..the device's channels;
-// unit and level 0..1.
+//   pause-master durationMs=T       scenarios only: the runner's master sends nothing for T ms
+//
+// A delay's and pause-master's duration is durationMs=T or, in a scenario of our master (whose
+// cycle time is known), durationCycles=N; exactly one of them.
+//
+// Every action is parsed into a typed Fault (parseFault) before it runs: when a scenario is
+// loaded, when a control line arrives. Every argument has a range and a value outside it is
+// refused with the range in the message ("loss: rate=nan is not a number in [0, 1]"); NaN,
+// infinities and integers that do not fit are refused, never truncated. rate in [0, 1]; ns in
+// [0, kMaxDelaySpikeNs] (1 s); durationMs in [0, kMaxFaultDurationMs] (one day),
+// durationCycles as long at most; count in [0, kMaxCorruptCount]; codes and indexes within
+// their wire width (al-error/drive-fault code and sdo-abort index 16 bits, sdo-abort code 32
+// bits, sub 8 bits); port 0..3; on 0..1; channel 1..kMaxFaultChannel (when applied: 1..the
+// device's channels); unit and level 0..1; state and kind by name. Slaves and cables are
+// looked up when the fault is applied (a scenario's names are checked against its topology at
+// load: scenario/scenario.hpp, checkTopologyNames).
 // Clearing: a fault's zero removes it. "loss rate=0" ends the loss, "corrupt count=0" drops
 // the corruptions still pending at that cable, "delay ns=0" removes the cable's delay spikes;
 // the others have their opposite verb or on=0 (link-up, power-on, mailbox-ok, sdo-ok,
@@ -48,10 +57,13 @@
 #include <string>
 #include <string_view>
 #include <utility>
+#include <variant>
 #include <vector>
 
+#include "protocol/al_status.hpp"
 #include "protocol/result.hpp"
 #include "protocol/time.hpp"
+#include "slavesim/devices/signal.hpp"
 #include "topology/network_builder.hpp"
 #include "topology/segment.hpp"
 
@@ -78,6 +90,7 @@ constexpr std::uint64_t kMaxDelaySpikeNs = 1'000'000'000;  // 1 s per spike, eac
 constexpr std::uint64_t kMaxFaultDurationMs = 86'400'000;  // one day
 constexpr std::uint64_t kMaxCorruptCount = 1'000'000;      // pending, per cable end
 constexpr std::size_t kMaxDelaySpikes = 64;                // active at once
+constexpr std::uint64_t kMaxFaultChannel = 255;            // before the device is known
 
 struct FaultAction {
   std::string verb;
@@ -101,18 +114,128 @@ struct FaultAction {
   std::string text() const;
 };
 
+// Where an action is written: a scenario takes pause-master and durationCycles (the runner's
+// master and cycle), a control line (ecsim serve) does not.
+enum class FaultScope : std::uint8_t { kControl, kScenario };
+
 // "verb key=value key="quoted value" ..." (a control line; a final CR is ignored). Refused,
 // naming the column: a byte that is not printable, an unterminated quote, an empty or repeated
 // argument name; and what checkFaultArguments refuses.
 Result<FaultAction> parseFaultAction(std::string_view line);
 // An unknown verb, or an argument the verb does not take, is an error naming the closest valid
 // name (or listing the valid ones).
-Status checkFaultArguments(const FaultAction& action);
-// The verbs FaultInjector applies; the arguments a verb takes (empty for an unknown verb).
-std::vector<std::string_view> faultVerbs();
-std::vector<std::string_view> faultArguments(std::string_view verb);
+Status checkFaultArguments(const FaultAction& action, FaultScope scope = FaultScope::kControl);
+// The verbs of `scope`; the arguments a verb takes there (empty for an unknown verb). One table
+// (topology/fault_parse.cpp) answers both, for scenarios, control lines and `ecsim ctl help`.
+std::vector<std::string_view> faultVerbs(FaultScope scope = FaultScope::kControl);
+std::vector<std::string_view> faultArguments(std::string_view verb,
+                                             FaultScope scope = FaultScope::kControl);
 // Decimal or 0x-prefixed hexadecimal.
 std::optional<std::uint64_t> parseNumber(std::string_view text);
+
+// ---- Typed faults ---------------------------------------------------------------------------
+// Where a wire fault acts: a named cable (its downstream end), or a slave's port.
+struct FaultPlace {
+  std::string cable;  // empty: slave and port
+  std::string slave;
+  unsigned port{0};
+};
+struct LinkDown {
+  FaultPlace at;
+};
+struct LinkUp {
+  FaultPlace at;
+};
+struct Loss {
+  std::string cable;  // empty: the master's
+  double rate{0};
+};
+struct Corrupt {
+  FaultPlace at;
+  std::uint64_t count{1};
+};
+struct Delay {
+  FaultPlace at;
+  SimTime extra{0};  // each way
+  SimTime duration{0};
+};
+struct PowerOff {
+  std::string slave;
+};
+struct PowerOn {
+  std::string slave;
+};
+struct PowerCycle {
+  std::string slave;
+};
+struct AlError {
+  std::string slave;
+  std::uint16_t code{0};
+  std::optional<AlState> state;  // none: the slave's state, at most SAFEOP
+};
+struct EepromChecksum {
+  std::string slave;
+};
+struct MailboxSilent {
+  std::string slave;
+  bool silent{true};  // false: answering again (mailbox-ok)
+};
+struct SdoAbortFault {
+  std::string slave;
+  std::uint16_t index{0};
+  std::optional<std::uint8_t> subindex;  // none: every subindex
+  std::uint32_t code{0x06020000};        // object does not exist
+};
+struct SdoOk {
+  std::string slave;
+};
+struct DriveFault {
+  std::string slave;
+  std::uint16_t code{0x2310};  // overcurrent
+};
+struct EncoderFault {
+  enum class Kind : std::uint8_t { kData, kFrame, kPower };
+  std::string slave;
+  Kind kind{Kind::kData};
+  bool on{true};
+  unsigned channel{1};
+};
+struct Input {
+  std::string slave;
+  unsigned channel{1};
+  std::string text;  // as written
+  slavesim::devices::Signal signal;
+};
+struct Latch {
+  std::string slave;
+  unsigned unit{0};
+  bool level{false};
+};
+struct PauseMaster {  // scenarios: carried out by the runner, not by FaultInjector
+  SimTime duration{0};
+};
+using Fault = std::variant<LinkDown, LinkUp, Loss, Corrupt, Delay, PowerOff, PowerOn, PowerCycle,
+                           AlError, EepromChecksum, MailboxSilent, SdoAbortFault, SdoOk, DriveFault,
+                           EncoderFault, Input, Latch, PauseMaster>;
+
+// What parseFault needs besides the action: where it is written and, for durationCycles, the
+// cycle time of the master that counts the cycles (0: none known, durationCycles refused).
+struct FaultContext {
+  FaultScope scope{FaultScope::kControl};
+  SimTime cycleTime{0};
+};
+// Checks and converts every argument (checkFaultArguments, the ranges above, names of states
+// and kinds with the closest valid one, the input signal's text); errors begin with the
+// action's `where` and verb.
+Result<Fault> parseFault(const FaultAction& action, const FaultContext& context = {});
+// A control line: parseFaultAction, then parseFault.
+Result<Fault> parseFaultLine(std::string_view line);
+// The verb of a fault, and the fault as an action line ("delay cable=drives ns=5000
+// durationMs=20"): what was parsed, for logs; parseFaultLine reads it back to the same fault
+// (a duration given in cycles is written in ms).
+std::string_view verbOf(const Fault& fault);
+std::string describe(const Fault& fault);
+std::string_view toString(EncoderFault::Kind kind);
 
 class FaultInjector final : public WireFaults {
  public:
@@ -123,8 +246,11 @@ class FaultInjector final : public WireFaults {
   FaultInjector& operator=(const FaultInjector&) = delete;
 
   static bool handles(std::string_view verb);
-  // Applies a network-side action at simulation time `now`; returns what was done in words.
-  Result<std::string> apply(const FaultAction& action, SimTime now);
+  // Applies a network-side fault at simulation time `now`; returns what was done in words. A
+  // slave or cable the network does not have, or a channel or unit the slave's device does
+  // not have, is an error (naming the closest name); pause-master is not the network's.
+  // Errors begin with `where` ("s.xml, line 7" or "control") and the verb.
+  Result<std::string> apply(const Fault& fault, SimTime now, std::string_view where = {});
 
   bool corrupts(std::size_t slave, unsigned port, SimTime time) override;
   SimTime extraDelay(std::size_t slave, unsigned port, SimTime time) override;
@@ -143,7 +269,28 @@ class FaultInjector final : public WireFaults {
     SimTime extra{0};
     SimTime until{0};
   };
-  Result<End> cableEnd(const FaultAction& action) const;
+  Result<End> cableEnd(const FaultPlace& at) const;
+  Result<std::size_t> slaveNamed(std::string_view name) const;  // errors "no slave named ..."
+  // One overload per fault (faults.cpp).
+  Result<std::string> on(const LinkDown& f, SimTime now);
+  Result<std::string> on(const LinkUp& f, SimTime now);
+  Result<std::string> on(const Loss& f, SimTime now);
+  Result<std::string> on(const Corrupt& f, SimTime now);
+  Result<std::string> on(const Delay& f, SimTime now);
+  Result<std::string> on(const PowerOff& f, SimTime now);
+  Result<std::string> on(const PowerOn& f, SimTime now);
+  Result<std::string> on(const PowerCycle& f, SimTime now);
+  Result<std::string> on(const AlError& f, SimTime now);
+  Result<std::string> on(const EepromChecksum& f, SimTime now);
+  Result<std::string> on(const MailboxSilent& f, SimTime now);
+  Result<std::string> on(const SdoAbortFault& f, SimTime now);
+  Result<std::string> on(const SdoOk& f, SimTime now);
+  Result<std::string> on(const DriveFault& f, SimTime now);
+  Result<std::string> on(const EncoderFault& f, SimTime now);
+  Result<std::string> on(const Input& f, SimTime now);
+  Result<std::string> on(const Latch& f, SimTime now);
+  Result<std::string> on(const PauseMaster& f, SimTime now);
+  Result<std::string> setLink(const FaultPlace& at, bool up);
   // The other end of the cable at `end`, if there is one (the master cable has none).
   std::optional<End> peer(End end) const;
   void setCable(End end, bool up);

@@ -7,6 +7,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "protocol/closest_name.hpp"
 #include "protocol/read_file.hpp"
 
 namespace ecsim::slavesim::devices {
@@ -221,8 +222,9 @@ Result<Signal> parseSignal(std::string_view text, const std::filesystem::path& b
     if (problem.empty() && args.empty()) return Signal::fromCsv(path, loop, step);
   } else {
     return makeError(ErrorCode::kParse,
-                     "signal \"" + std::string(text) +
-                         "\": unknown kind (constant, square, sine, ramp, csv or a number)");
+                     "signal \"" + std::string(text) + "\": unknown kind '" + kind +
+                         "' (constant, square, sine, ramp, csv or a number)" +
+                         didYouMean(kind, {"constant", "square", "sine", "ramp", "csv"}));
   }
   if (problem.empty() && !args.empty()) problem = "unknown parameter '" + args.begin()->first + "'";
   if (!problem.empty()) {

@@ -90,9 +90,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const std::string_view line = rest.substr(0, end);
     rest = end == std::string_view::npos ? std::string_view() : rest.substr(end + 1);
     if (line.find("csv") != std::string_view::npos) continue;
-    auto action = topology::parseFaultAction(line);
-    if (!action.ok()) continue;
-    if (faults.apply(*action, now).ok() && !changesOnlyTheInjector(action->verb)) changed = true;
+    auto fault = topology::parseFaultLine(line);
+    if (!fault.ok()) continue;
+    if (faults.apply(*fault, now).ok() && !changesOnlyTheInjector(topology::verbOf(*fault))) {
+      changed = true;
+    }
     now += 1'000'000;
   }
   if (changed) ++changedInputs;

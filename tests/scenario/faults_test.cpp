@@ -6,6 +6,7 @@
 #include "protocol/ethernet.hpp"
 #include "protocol/frame.hpp"
 #include "slavesim/generic_slave.hpp"
+#include "topology/control_server.hpp"
 #include "topology/faults.hpp"
 #include "topology/network_builder.hpp"
 
@@ -43,10 +44,10 @@ std::uint16_t firstWkc(std::vector<std::uint8_t>& frame) {
   return parsed.ok() ? (*parsed->begin()).wkc() : 0;
 }
 
-FaultAction action(const std::string& line) {
-  auto a = parseFaultAction(line);
-  EXPECT_TRUE(a.ok()) << line;
-  return *a;
+Fault action(const std::string& line) {
+  auto a = parseFaultLine(line);
+  EXPECT_TRUE(a.ok()) << line << ": " << a.error().context;
+  return a.ok() ? *a : Fault{};
 }
 
 TEST(Faults, CorruptionIsCountedAtTheReceiverAndForwardedAfterIt) {
@@ -140,10 +141,12 @@ TEST(Faults, ErrorsNameWhatIsWrong) {
   auto r = faults.apply(action("link-down cable=nowhere"), 0);
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.error().context.find("nowhere"), std::string::npos);
-  r = faults.apply(action("al-error slave=S0"), 0);
-  ASSERT_FALSE(r.ok());
-  EXPECT_NE(r.error().context.find("code"), std::string::npos);
+  // A missing argument is found when the line is parsed, before anything is applied.
+  auto missing = parseFaultLine("al-error slave=S0");
+  ASSERT_FALSE(missing.ok());
+  EXPECT_EQ(missing.error().context, "control: al-error: missing argument 'code'");
   EXPECT_FALSE(FaultInjector::handles("explode"));
+  EXPECT_FALSE(FaultInjector::handles("pause-master")) << "the runner's, not the network's";
 }
 
 TEST(FaultAction, ParsesQuotedValuesAndRoundTrips) {
@@ -160,9 +163,9 @@ TEST(FaultAction, ParsesQuotedValuesAndRoundTrips) {
 
 // Issue #21: every argument has a range, the error names it; NaN, infinities and integers that
 // do not fit are refused, never truncated or wrapped.
+// Issue #16: they are found when the action is parsed (a scenario loaded, a control line read),
+// not when it is applied.
 TEST(FaultArguments, OutOfRangeNumbersAreRefusedWithTheRange) {
-  Network net = makeLine(2);
-  FaultInjector faults(net, 1);
   struct Case {
     const char* line;
     const char* expected;  // in the error
@@ -189,10 +192,11 @@ TEST(FaultArguments, OutOfRangeNumbersAreRefusedWithTheRange) {
       {"link-down slave=S0 port=4294967296", "[0, 3]"},
   };
   for (const Case& c : cases) {
-    auto r = faults.apply(action(c.line), 0);
-    ASSERT_FALSE(r.ok()) << c.line << " was accepted: " << *r;
+    auto r = parseFaultLine(c.line);
+    ASSERT_FALSE(r.ok()) << c.line << " was accepted: " << describe(*r);
     EXPECT_NE(r.error().context.find(c.expected), std::string::npos)
         << c.line << ": " << r.error().context;
+    EXPECT_EQ(r.error().context.rfind("control: ", 0), 0u) << r.error().context;
   }
 }
 
@@ -271,6 +275,142 @@ TEST(FaultAction, UnknownNamesAreRefusedNamingTheClosestValidOne) {
   EXPECT_EQ(refusal("sdo-abort slave=S1 index=0x6040 sub=0 code=0x06020000"), "");
   EXPECT_EQ(refusal("encoder-fault slave=S1 kind=frame on=0 channel=2"), "");
   EXPECT_EQ(refusal("delay slave=S1 port=1 ns=100 durationMs=5"), "");
+}
+
+// Every verb parses into its typed fault, and describe() writes it back as a line that parses
+// to the same fault (defaults written out, names of states and kinds kept).
+TEST(TypedFaults, EveryVerbParsesAndDescribesItselfBack) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"link-down cable=drives", "link-down cable=drives"},
+      {"link-up slave=S1 port=1", "link-up slave=S1 port=1"},
+      {"loss rate=0.25", "loss rate=0.25"},
+      {"loss rate=1 cable=c1", "loss rate=1 cable=c1"},
+      {"corrupt cable=c1", "corrupt cable=c1 count=1"},
+      {"delay slave=S1 port=0 ns=5000 durationMs=2.5",
+       "delay slave=S1 port=0 ns=5000 durationMs=2.5"},
+      {"power-off slave=S1", "power-off slave=S1"},
+      {"power-on slave=S1", "power-on slave=S1"},
+      {"power-cycle slave=S1", "power-cycle slave=S1"},
+      {"al-error slave=S1 code=27", "al-error slave=S1 code=0x001b"},
+      {"al-error slave=S1 code=0x1A state=PREOP", "al-error slave=S1 code=0x001a state=PREOP"},
+      {"eeprom-checksum slave=S1", "eeprom-checksum slave=S1"},
+      {"mailbox-silent slave=S1", "mailbox-silent slave=S1"},
+      {"mailbox-silent slave=S1 on=0", "mailbox-ok slave=S1"},
+      {"mailbox-ok slave=S1", "mailbox-ok slave=S1"},
+      {"sdo-abort slave=S1 index=0x1C12", "sdo-abort slave=S1 index=0x1c12 code=0x06020000"},
+      {"sdo-abort slave=S1 index=0x1C12 sub=0 code=0x08000022",
+       "sdo-abort slave=S1 index=0x1c12 sub=0 code=0x08000022"},
+      {"sdo-ok slave=S1", "sdo-ok slave=S1"},
+      {"drive-fault slave=S1", "drive-fault slave=S1 code=0x2310"},
+      {"encoder-fault slave=S1", "encoder-fault slave=S1 kind=data on=1 channel=1"},
+      {"encoder-fault slave=S1 kind=power on=0 channel=2",
+       "encoder-fault slave=S1 kind=power on=0 channel=2"},
+      {"input slave=S1 channel=2 signal=\"sine amplitude=5\"",
+       "input slave=S1 channel=2 signal=\"sine amplitude=5\""},
+      {"latch slave=S1 unit=1 level=1", "latch slave=S1 unit=1 level=1"},
+  };
+  for (const auto& [line, expected] : cases) {
+    auto f = parseFaultLine(line);
+    ASSERT_TRUE(f.ok()) << line << ": " << f.error().context;
+    EXPECT_EQ(describe(*f), expected) << line;
+    auto again = parseFaultLine(describe(*f));
+    ASSERT_TRUE(again.ok()) << describe(*f) << ": " << again.error().context;
+    EXPECT_EQ(describe(*again), expected);
+  }
+  // The typed values themselves.
+  auto abort = parseFaultLine("sdo-abort slave=S1 index=0x1C12 sub=3 code=0x06010000");
+  ASSERT_TRUE(abort.ok());
+  const auto& a = std::get<SdoAbortFault>(*abort);
+  EXPECT_EQ(a.index, 0x1C12);
+  EXPECT_EQ(a.subindex, std::optional<std::uint8_t>(3));
+  EXPECT_EQ(a.code, 0x06010000u);
+  auto state = parseFaultLine("al-error slave=S1 code=0x1B state=INIT");
+  ASSERT_TRUE(state.ok());
+  EXPECT_EQ(std::get<AlError>(*state).state, std::optional<AlState>(AlState::kInit));
+  auto input = parseFaultLine("input slave=S1 channel=1 signal=\"square period=0.5\"");
+  ASSERT_TRUE(input.ok());
+  EXPECT_EQ(std::get<Input>(*input).signal.kind(), slavesim::devices::Signal::Kind::kSquare);
+}
+
+// Names of states, kinds and signals are refused with the closest valid one; a cable and a
+// slave port at once is refused (which one was meant?).
+TEST(TypedFaults, NamesAndPlacesAreCheckedWhenParsed) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"al-error slave=S1 code=1 state=SAFE-OP",
+       "control: al-error: state=SAFE-OP is not INIT, PREOP, BOOT, SAFEOP or OP; did you mean "
+       "'SAFEOP'?"},
+      {"encoder-fault slave=S1 kind=fram",
+       "control: encoder-fault: kind=fram is not data, frame or power; did you mean 'frame'?"},
+      {"link-down cable=c1 slave=S1 port=1",
+       "control: link-down: takes cable=NAME or slave=NAME port=N, not both"},
+      {"link-down slave=S1", "control: link-down: missing argument 'port'"},
+      {"corrupt count=3", "control: corrupt: needs cable=NAME or slave=NAME port=N"},
+      {"input slave=S1 channel=1 signal=\"sqaure period=1\"", "did you mean 'square'?"},
+      {"delay cable=c1 ns=5", "control: delay: needs durationMs=T or durationCycles=N"},
+      // Cycles are the runner's: a control line has none.
+      {"delay cable=c1 ns=5 durationCycles=3",
+       "control: delay: unknown argument 'durationCycles' (valid: cable, durationMs, ns, port, "
+       "slave)"},
+      {"pause-master durationMs=5", "control: unknown action 'pause-master'"},
+  };
+  for (const auto& [line, expected] : cases) {
+    auto f = parseFaultLine(line);
+    ASSERT_FALSE(f.ok()) << line << " was accepted";
+    EXPECT_NE(f.error().context.find(expected), std::string::npos)
+        << line << ": " << f.error().context;
+  }
+}
+
+// The control socket's answer to a line: parsed first (nothing applied when an argument is
+// wrong), then applied; errors say "control" and the verb.
+TEST(TypedFaults, ControlLinesAreParsedThenApplied) {
+  Network net = makeLine(3);
+  FaultInjector faults(net, 1);
+  EXPECT_EQ(answerFaultLine(faults, "loss rate=1.5 cable=c1", 0),
+            "error control: loss: rate=1.5 is not a number in [0, 1]");
+  auto frame = brdFrame();
+  EXPECT_TRUE(net.segment->processFrame(frame, 0).delivered) << "nothing was applied";
+  EXPECT_EQ(answerFaultLine(faults, "link-down cable=c3", 0),
+            "error control: link-down: no cable named 'c3'; did you mean 'c1'?");
+  EXPECT_EQ(answerFaultLine(faults, "link-down cable=c2", 0), "ok link down at S2 port 0");
+  EXPECT_EQ(answerFaultLine(faults, "pause-master durationMs=5", 0).rfind(
+                "error control: unknown action 'pause-master'", 0),
+            0u);
+}
+
+// A scenario's durations in cycles of its master: exactly one of durationMs and durationCycles.
+TEST(TypedFaults, DurationsInMillisecondsOrCycles) {
+  auto scenarioAction = [](std::map<std::string, std::string, std::less<>> args, SimTime cycle) {
+    FaultAction a;
+    a.verb = args.count("ns") != 0 ? "delay" : "pause-master";
+    a.args = std::move(args);
+    a.where = "s.xml, line 7";
+    return parseFault(a, {FaultScope::kScenario, cycle});
+  };
+  auto d = scenarioAction({{"cable", "c1"}, {"ns", "500"}, {"durationCycles", "20"}}, 250'000);
+  ASSERT_TRUE(d.ok()) << d.error().context;
+  EXPECT_EQ(std::get<Delay>(*d).duration, 5 * kNsPerMs);
+  auto p = scenarioAction({{"durationCycles", "8"}}, kNsPerMs);
+  ASSERT_TRUE(p.ok()) << p.error().context;
+  EXPECT_EQ(std::get<PauseMaster>(*p).duration, 8 * kNsPerMs);
+  auto ms = scenarioAction({{"durationMs", "12.5"}}, kNsPerMs);
+  ASSERT_TRUE(ms.ok());
+  EXPECT_EQ(std::get<PauseMaster>(*ms).duration, 12'500'000);
+
+  auto both = scenarioAction({{"durationMs", "5"}, {"durationCycles", "5"}}, kNsPerMs);
+  ASSERT_FALSE(both.ok());
+  EXPECT_EQ(both.error().context,
+            "s.xml, line 7: pause-master: takes durationMs=T or durationCycles=N, not both");
+  auto external = scenarioAction({{"durationCycles", "5"}}, 0);
+  ASSERT_FALSE(external.ok());
+  EXPECT_NE(external.error().context.find("durationCycles needs our master's cycle time"),
+            std::string::npos);
+  // At most a day, as durationMs.
+  auto long_ = scenarioAction({{"durationCycles", "86400001"}}, kNsPerMs);
+  ASSERT_FALSE(long_.ok());
+  EXPECT_NE(long_.error().context.find("durationCycles=86400001 is not a number in [0, 86400000]"),
+            std::string::npos)
+      << long_.error().context;
 }
 
 }  // namespace

@@ -44,6 +44,28 @@ TEST(ScenarioFile, ReadsActionsAndExpectations) {
   EXPECT_EQ(s->expectations[0].line, 8);
 }
 
+// Issue #16: moments and spans in ms or in cycles; ours converts one into the other with its
+// cycle time (here 1000 us; a time between two cycle starts means the next cycle).
+TEST(ScenarioFile, TimesInMillisecondsOrCycles) {
+  auto s = parseScenario(
+      wrap("<Timeline>\n"
+           "  <Action cycle=\"5\" do=\"delay\" cable=\"drives\" ns=\"800\" durationCycles=\"30\"/>\n"
+           "  <Action cycle=\"40\" do=\"pause-master\" durationCycles=\"12\"/>\n"
+           "</Timeline>\n<Expect>\n"
+           "  <Detected condition=\"slave-lost\" afterMs=\"40.5\" withinMs=\"10\"/>\n"
+           "  <BackInOp afterMs=\"60\" withinCycles=\"25\"/>\n"
+           "</Expect>\n"),
+      "/x/s.xml");
+  ASSERT_TRUE(s.ok()) << s.error().message();
+  EXPECT_EQ(std::get<topology::Delay>(s->actions[0].fault).duration, 30 * kNsPerMs);
+  EXPECT_EQ(std::get<topology::PauseMaster>(s->actions[1].fault).duration, 12 * kNsPerMs);
+  EXPECT_EQ(s->expectations[0].afterCycle, 41u);
+  EXPECT_EQ(s->expectations[0].withinCycles, 10u);
+  EXPECT_EQ(s->expectations[1].afterCycle, 60u);
+  EXPECT_FALSE(s->expectations[1].afterTime) << "ours counts cycles";
+  EXPECT_EQ(s->expectations[1].within, 25 * kNsPerMs);
+}
+
 TEST(ScenarioFile, ErrorsNameFileAndLine) {
   auto s = parseScenario(wrap("<Timeline>\n  <Action do=\"link-down\"/>\n</Timeline>\n"
                               "<Expect><State slave=\"A\" state=\"OP\"/></Expect>\n"),
@@ -139,6 +161,40 @@ TEST(Runner, AFailingExpectationSaysWhatWhenAndWhat) {
   EXPECT_NE(report.find("at 700.000 ms: SAFEOP"), std::string::npos) << report;
   const std::string junit = formatJunit({r});
   EXPECT_NE(junit.find("<failure message=\"at 700.000 ms: SAFEOP"), std::string::npos) << junit;
+}
+
+// Issue #16 item 3: a <Variable> by the name the master gives it from the topology's slave
+// names; the names exist once the master has scanned, so the runner checks them when the run
+// starts and a name not found is a scenario error listing the closest names.
+TEST(Runner, VariablesByTheirNames) {
+  auto s = loadScenario(kDir / "drive_fault.xml");
+  ASSERT_TRUE(s.ok()) << s.error().message();
+  s->duration = 400 * kNsPerMs;
+  s->actions.clear();
+  s->expectations.clear();
+  Expectation x;
+  x.line = 41;
+  x.kind = ExpectKind::kVariable;
+  x.variable = "Drive1.Statusword";
+  // The runner writes no controlword: the drive stays in Switch on disabled (CiA 402,
+  // statusword xxxx xxxx x1xx 0000).
+  x.mask = 0x004F;
+  x.value = 0x0040;
+  x.atCycle = 300;
+  s->expectations.push_back(x);
+  auto r = runScenario(*s);
+  ASSERT_TRUE(r.error.empty()) << r.error;
+  ASSERT_EQ(r.results.size(), 1u);
+  EXPECT_TRUE(r.results[0].passed) << r.results[0].observed;
+  EXPECT_EQ(r.results[0].what, "Variable Drive1.Statusword == 64 at cycle 300");
+
+  s->expectations[0].variable = "Drive1.StatusWord";
+  r = runScenario(*s);
+  // The engine reports a start error as Error::message() ("not found: FILE, line N: ...").
+  EXPECT_NE(r.error.find((kDir / "drive_fault.xml").string() + ", line 41: "), std::string::npos)
+      << r.error;
+  EXPECT_NE(r.error.find("'Drive1.StatusWord'; closest: Drive1.Statusword"), std::string::npos)
+      << r.error;
 }
 
 std::string slurp(const std::filesystem::path& p) {

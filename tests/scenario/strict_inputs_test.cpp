@@ -9,6 +9,7 @@
 // the closest name or on another line, and 3 (control lines: the verb table of commit 46b5a62)
 // passed as now.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -17,6 +18,7 @@
 #include "config/master_config.hpp"
 #include "config/topology_file.hpp"
 #include "scenario/scenario.hpp"
+#include "topology/control_server.hpp"
 #include "topology/faults.hpp"
 #include "topology/network_builder.hpp"
 
@@ -28,8 +30,8 @@ enum class Format {
   kScenario,      // parseScenario("/cases/s.xml")
   kScenarioFile,  // loadScenario: s.xml beside net.xml (kNet), checked against it
   kMasterConfig,  // parseMasterConfig("/cases/m.xml")
-  kControl,       // a control line (ecsim ctl, the control socket): parseFaultAction
-  kControlApply,  // the same, applied to the network of kNet
+  kControl,       // a control line (ecsim ctl, the control socket): parseFaultLine
+  kControlApply,  // the same, answered by the control socket serving the network of kNet
 };
 
 struct Case {
@@ -70,14 +72,25 @@ std::string masterFile(const std::string& slave) {  // the slave on line 2
   return "<EcsimMaster>\n" + slave + "\n</EcsimMaster>\n";
 }
 
+// One folder per process, removed at its end: ctest -j runs the rows in parallel processes,
+// and one writing net.xml while another read it made a row fail now and then.
+struct CaseDir {
+  std::filesystem::path path;
+  CaseDir()
+      : path(std::filesystem::temp_directory_path() /
+             ("ecsim_strict_inputs_test." + std::to_string(::getpid()))) {
+    std::filesystem::create_directories(path);
+    std::ofstream(path / "net.xml") << kNet;
+  }
+  ~CaseDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path, ec);
+  }
+};
+
 const std::filesystem::path& caseDir() {
-  static const std::filesystem::path dir = [] {
-    auto d = std::filesystem::temp_directory_path() / "ecsim_strict_inputs_test";
-    std::filesystem::create_directories(d);
-    std::ofstream(d / "net.xml") << kNet;
-    return d;
-  }();
-  return dir;
+  static const CaseDir dir;
+  return dir.path;
 }
 
 // The error of reading the row's text (empty when it was accepted), and the file it names.
@@ -96,16 +109,15 @@ std::pair<std::string, std::string> refusal(const Case& c) {
     case Format::kMasterConfig:
       return {message(parseMasterConfig(c.text, "/cases/m.xml")), "/cases/m.xml"};
     case Format::kControl:
-      return {message(topology::parseFaultAction(c.text)), "control"};
-    case Format::kControlApply: {
-      auto action = topology::parseFaultAction(c.text);
-      if (!action.ok()) return {action.error().context, "control"};
+      return {message(topology::parseFaultLine(c.text)), "control"};
+    case Format::kControlApply: {  // as the control socket answers it
       auto config = parseTopology(kNet, caseDir() / "net.xml");
       EXPECT_TRUE(config.ok());
       auto network = topology::buildNetwork(*config);
       EXPECT_TRUE(network.ok());
       topology::FaultInjector faults(*network, 1);
-      return {message(faults.apply(*action, 0)), "control"};
+      const std::string reply = topology::answerFaultLine(faults, c.text, 0);
+      return {reply.rfind("error ", 0) == 0 ? reply.substr(6) : std::string(), "control"};
     }
   }
   return {};
@@ -271,6 +283,96 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"expectation after the end", Format::kScenario,
              expect("<State slave=\"Drive1\" state=\"OP\" cycle=\"500\"/>"), 3,
              "cycle=\"500\" is after the end of the run (100 cycles)"}));
+
+// ---- fault arguments, parsed into typed faults when the scenario is read (issue #16 item 2) --
+// Before, each was accepted at load and refused only when the timeline reached it, mid-run.
+INSTANTIATE_TEST_SUITE_P(
+    FaultArguments, StrictInputs,
+    ::testing::Values(
+        Case{"loss rate", Format::kScenario,
+             timeline("<Action cycle=\"1\" do=\"loss\" rate=\"1.5\"/>"), 3,
+             "loss: rate=1.5 is not a number in [0, 1]"},
+        Case{"al-error code", Format::kScenario,
+             timeline("<Action cycle=\"1\" do=\"al-error\" slave=\"Drive1\" code=\"0x10000\"/>"), 3,
+             "al-error: code=0x10000 is not a number in [0, 0xffff]"},
+        Case{"al-error state", Format::kScenario,
+             timeline("<Action cycle=\"1\" do=\"al-error\" slave=\"Drive1\" code=\"0x1B\" "
+                      "state=\"SAFE-OP\"/>"),
+             3, "did you mean 'SAFEOP'?"},
+        Case{"sdo-abort sub", Format::kScenario,
+             timeline("<Action cycle=\"1\" do=\"sdo-abort\" slave=\"Drive1\" index=\"0x1C12\" "
+                      "sub=\"300\"/>"),
+             3, "sdo-abort: sub=300 is not a number in [0, 255]"},
+        Case{"latch unit", Format::kScenario,
+             timeline("<Action cycle=\"1\" do=\"latch\" slave=\"Drive1\" unit=\"2\" level=\"1\"/>"),
+             3, "latch: unit=2 is not a number in [0, 1]"},
+        Case{"delay ns", Format::kScenario,
+             timeline("<Action cycle=\"1\" do=\"delay\" cable=\"drives\" ns=\"-1\" "
+                      "durationMs=\"5\"/>"),
+             3, "delay: ns=-1 is not a number in [0, 1000000000]"},
+        Case{"delay without duration", Format::kScenario,
+             timeline("<Action cycle=\"1\" do=\"delay\" cable=\"drives\" ns=\"500\"/>"), 3,
+             "delay: needs durationMs=T or durationCycles=N"},
+        Case{"encoder-fault kind", Format::kScenario,
+             timeline("<Action cycle=\"1\" do=\"encoder-fault\" slave=\"Drive1\" kind=\"bogus\"/>"),
+             3, "encoder-fault: kind=bogus is not data, frame or power"},
+        Case{"encoder-fault kind near", Format::kScenario,
+             timeline("<Action cycle=\"1\" do=\"encoder-fault\" slave=\"Drive1\" kind=\"fram\"/>"),
+             3, "did you mean 'frame'?"},
+        Case{"link-down port", Format::kScenario,
+             timeline("<Action cycle=\"1\" do=\"link-down\" slave=\"Drive1\" port=\"4\"/>"), 3,
+             "link-down: port=4 is not a number in [0, 3]"},
+        Case{"link-down cable and slave", Format::kScenario,
+             timeline("<Action cycle=\"1\" do=\"link-down\" cable=\"drives\" slave=\"Drive1\" "
+                      "port=\"1\"/>"),
+             3, "link-down: takes cable=NAME or slave=NAME port=N, not both"},
+        Case{"corrupt count", Format::kScenario,
+             timeline("<Action cycle=\"1\" do=\"corrupt\" cable=\"drives\" count=\"1e3\"/>"), 3,
+             "corrupt: count=1e3 is not a number in [0, 1000000]"},
+        Case{"mailbox-silent on", Format::kScenario,
+             timeline("<Action cycle=\"1\" do=\"mailbox-silent\" slave=\"Drive1\" on=\"yes\"/>"),
+             3, "mailbox-silent: on=yes is not a number in [0, 1]"},
+        Case{"input signal", Format::kScenario,
+             timeline("<Action cycle=\"1\" do=\"input\" slave=\"Drive1\" channel=\"1\" "
+                      "signal=\"sqaure period=1\"/>"),
+             3, "did you mean 'square'?"},
+        Case{"input channel", Format::kScenario,
+             timeline("<Action cycle=\"1\" do=\"input\" slave=\"Drive1\" channel=\"0\" "
+                      "signal=\"constant value=1\"/>"),
+             3, "input: channel=0 is not a number in [1, "},
+        Case{"drive-fault missing slave", Format::kScenario,
+             timeline("<Action cycle=\"1\" do=\"drive-fault\" code=\"0x2310\"/>"), 3,
+             "drive-fault: missing argument 'slave'"},
+        Case{"pause-master durationMs", Format::kScenario,
+             timeline("<Action cycle=\"1\" do=\"pause-master\" durationMs=\"-5\"/>"), 3,
+             "pause-master: durationMs=-5 is not a number in [0, 86400000]"},
+        // Durations in ms or in cycles (issue #16 item 2): one of the two, never both.
+        Case{"delay both durations", Format::kScenario,
+             timeline("<Action cycle=\"1\" do=\"delay\" cable=\"drives\" ns=\"500\" "
+                      "durationMs=\"5\" durationCycles=\"5\"/>"),
+             3, "delay: takes durationMs=T or durationCycles=N, not both"},
+        Case{"pause-master cycles of an external master", Format::kScenario,
+             scenario(kExternal + "<Timeline>\n<Action timeMs=\"1\" do=\"pause-master\" "
+                                  "durationCycles=\"5\"/>\n</Timeline>\n" +
+                      kExpect),
+             4, "pause-master: durationCycles needs our master's cycle time"},
+        Case{"State cycle and atMs", Format::kScenario,
+             expect("<State slave=\"Drive1\" state=\"OP\" cycle=\"5\" atMs=\"5\"/>"), 3,
+             "State takes cycle=\"N\" or atMs=\"T\", not both"},
+        Case{"Detected afterCycle and afterMs", Format::kScenario,
+             expect("<Detected condition=\"slave-lost\" afterCycle=\"5\" afterMs=\"5\" "
+                    "withinCycles=\"20\"/>"),
+             3, "Detected takes afterCycle=\"N\" or afterMs=\"T\", not both"},
+        Case{"BackInOp withinCycles and withinMs", Format::kScenario,
+             expect("<BackInOp afterCycle=\"5\" withinCycles=\"50\" withinMs=\"50\"/>"), 3,
+             "BackInOp takes withinCycles=\"N\" or withinMs=\"T\", not both"},
+        Case{"Variable name and entry", Format::kScenario,
+             expect("<Variable name=\"Drive1.Statusword\" slave=\"Drive1\" entry=\"0x6041:0\" "
+                    "value=\"0\"/>"),
+             3, "Variable takes name=\"SLAVE.ENTRY\" or slave and entry, not both"},
+        Case{"Detected afterMs after the end", Format::kScenario,
+             expect("<Detected condition=\"slave-lost\" afterMs=\"99.5\" withinMs=\"5\"/>"), 3,
+             "afterMs=\"99.5\" is after the end of the run (its last cycle is 99)"}));
 
 // ---- scenario files against their topology -----------------------------------------------
 INSTANTIATE_TEST_SUITE_P(

@@ -212,10 +212,10 @@ TEST(EncoderTerminal, EncoderFaultActionSetsAndClearsTheTerminalsFaults) {
   net->segment->pollSlaves(kNsPerMs);
   EXPECT_EQ(*slavesim::objectDictionaryOf(slave)->get<std::uint32_t>(0x6000, 0x11), 327680u)
       << "2.5 turns (drive.initialShaftAngle in the topology)";
-  auto apply = [&](const std::string& line) {
-    auto action = topology::parseFaultAction(line);
-    EXPECT_TRUE(action.ok());
-    return faults.apply(*action, kNsPerMs);
+  auto apply = [&](const std::string& line) -> Result<std::string> {
+    auto fault = topology::parseFaultLine(line);  // kind=noise is refused here
+    if (!fault.ok()) return fault.takeError();
+    return faults.apply(*fault, kNsPerMs);
   };
   ASSERT_TRUE(apply("encoder-fault slave=Encoder1").ok());
   EXPECT_EQ(t->fault(1), ef::kData) << "data is the default kind";

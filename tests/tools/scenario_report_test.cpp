@@ -146,6 +146,9 @@ TEST(CtlHelp, ListsTheActionsAndTheirArguments) {
   EXPECT_NE(run->output.find("  latch "), std::string::npos) << run->output;
   // pause-master pauses our master: a scenario action only, which no server takes.
   EXPECT_EQ(run->output.find("pause-master"), std::string::npos) << run->output;
+  // Nor durationCycles: cycles are the scenario runner's, a control line has none.
+  EXPECT_NE(run->output.find("  delay cable= durationMs= ns= port= slave="), std::string::npos)
+      << run->output;
 }
 
 }  // namespace

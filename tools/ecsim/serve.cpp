@@ -223,10 +223,7 @@ int runServe(ServeOptions o) {
     std::fflush(stdout);
   }
   auto handle = [&](std::string_view line) -> std::string {
-    auto action = topology::parseFaultAction(line);
-    if (!action.ok()) return "error " + action.error().context;
-    auto done = faults.apply(*action, clock.now());
-    return done.ok() ? "ok " + *done : "error " + done.error().context;
+    return topology::answerFaultLine(faults, line, clock.now());
   };
   // Captures reach the disk when the server idles and at least every kCaptureFlushInterval
   // under traffic; a capture error is reported at once and fails the run (it serves on).
