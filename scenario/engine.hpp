@@ -50,7 +50,7 @@ struct ExternalRunOptions {
   // The command's stdout and stderr go to DIR/<scenario name>.output.txt; empty: to a
   // temporary file that is removed after the run (the report keeps the last lines).
   std::filesystem::path outputDir;
-  bool realtime{true};        // SCHED_FIFO for the run's thread where permitted (veth, external)
+  bool realtime{true};        // SCHED_FIFO for the run's thread where permitted (veth only)
   std::size_t tailLines{12};  // output lines quoted in the report
   Environment environment;    // default: the process environment
 };

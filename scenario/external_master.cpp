@@ -107,7 +107,6 @@ class ExternalMaster final : public MasterUnderTest {
   std::filesystem::path outputFile_;
   std::optional<CommandOutput> output_;
   std::optional<ChildProcess> child_;
-  RealtimeScheduling scheduling_;
   CommandFacts facts_;
   std::optional<SimTime> zero_;
   bool zeroSeen_{false};
@@ -168,10 +167,10 @@ Status ExternalMaster::start() {
   }
   child_.emplace(std::move(*child));
   c_.log.add(facts_.start, "command started: " + s_.masterCommand);
-  // After the spawn: the command keeps the normal policy.
-  if (e_.realtime) {
-    if (auto note = scheduling_.enable(); !note.empty()) c_.log.add(facts_.start, "note: " + note);
-  }
+  // No SCHED_FIFO here (unlike veth, where nothing else needs the CPU): with the engine's one
+  // thread at SCHED_FIFO, SOEM's simple_test saw Drive2's SM watchdog expire while its frames
+  // kept their working counter (2 runs of 2 on a loaded 2-core machine; at normal priority
+  // and with the earlier simulator thread at SCHED_FIFO it passed). Cause not found yet.
   nextPoll_ = facts_.start;
   return okStatus();
 }
