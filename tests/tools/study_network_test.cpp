@@ -123,6 +123,27 @@ TEST(StudyNetwork, AnImageLargerThanOneFrameTakesTwoFrames) {
                 static_cast<SimTime>(8 + bytes[1] + 4) * 80);
 }
 
+TEST(StudyNetwork, AnEniGivesTheSameImageAsTheTopologyOfTheSameNetwork) {
+  // examples/eni/demo-eni.xml describes the devices of examples/topologies/demo.xml.
+  NetworkStudyOptions eni;
+  eni.topology = std::string(ECSIM_SOURCE_DIR) + "/examples/eni/demo-eni.xml";
+  eni.esiDir = std::string(ECSIM_SOURCE_DIR) + "/examples/esi";
+  NetworkStudyOptions topo;
+  topo.topology = std::string(ECSIM_SOURCE_DIR) + "/examples/topologies/demo.xml";
+  auto a = modelNetwork(eni);
+  auto b = modelNetwork(topo);
+  ASSERT_TRUE(a.ok()) << a.error().message();
+  ASSERT_TRUE(b.ok()) << b.error().message();
+  ASSERT_EQ(a->devices.size(), b->devices.size());
+  for (std::size_t i = 0; i < a->devices.size(); ++i) {
+    EXPECT_EQ(a->devices[i].outputBytes, b->devices[i].outputBytes) << i;
+    EXPECT_EQ(a->devices[i].inputBytes, b->devices[i].inputBytes) << i;
+  }
+  // 14 + 2 + (12 + 27 + 39) LRW + (12 + 8) FRMW.
+  EXPECT_EQ(a->cycle.frameBytes, 114u);
+  EXPECT_EQ(b->cycle.frameBytes, 114u);
+}
+
 TEST(StudyNetwork, AFileThatIsNoTopologyIsAnErrorNamingIt) {
   NetworkStudyOptions o;
   o.topology = writeTopology("bad", "  <Slave name=\"X\" product=\"#x1\" bogus=\"1\"/>\n").string();

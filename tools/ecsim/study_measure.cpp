@@ -154,6 +154,7 @@ Result<std::vector<MeasuredCycle>> measureNetwork(const NetworkStudyOptions& o,
   options.dc.enable = model.dc;
   master::Master m(link, bus, options);
   if (auto names = topology::loadSlaveNames(o.topology); names.ok()) m.setSlaveNames(*names);
+  if (isEniFile(o.topology)) ECSIM_TRY(m.loadConfig(o.topology));
   RealTimeThread rt;
   progress.update(fmt::format("measuring: bringing the served network to OP ({})", rt.note()),
                   true);

@@ -84,6 +84,11 @@ Error inFile(const NetworkStudyOptions& o, std::string_view what, const Error& e
 
 }  // namespace
 
+bool isEniFile(const std::string& path) {
+  auto root = xmlRootName(path);
+  return root.ok() && *root == "EtherCATConfig";
+}
+
 Result<NetworkModel> modelNetwork(const NetworkStudyOptions& o) {
   auto loaded = loadConfig(o);
   if (!loaded.ok()) return loaded.takeError();
@@ -116,6 +121,10 @@ Result<NetworkModel> modelNetwork(const NetworkStudyOptions& o) {
   options.dc.enable = useDc;
   master::Master m(links.first, bus, options);
   m.setSlaveNames(topology::slaveNamesInBusOrder(config));
+  // An ENI configures the master too: its identities, init commands and cyclic frames.
+  if (isEniFile(o.topology)) {
+    if (auto s = m.loadConfig(o.topology); !s.ok()) return inFile(o, "master configuration", s.error());
+  }
   if (auto s = m.start(); !s.ok()) return inFile(o, "bringing the network to OP", s.error());
 
   NetworkModel model;

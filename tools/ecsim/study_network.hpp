@@ -49,6 +49,9 @@ struct NetworkModel {
   topology::ModelledCycle cycle;
 };
 
+// True for an ENI (<EtherCATConfig>): the master then also loads it as its configuration.
+bool isEniFile(const std::string& path);
+
 // Builds the network of options.topology, brings it to OP with our master on virtual time and
 // models its cycle. Errors name the file.
 Result<NetworkModel> modelNetwork(const NetworkStudyOptions& options);
