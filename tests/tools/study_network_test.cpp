@@ -194,5 +194,31 @@ TEST(StudyNetwork, PlotHasReferenceLinesInsideTheFittedRange) {
   EXPECT_EQ(slow.find("measured"), std::string::npos) << slow;
 }
 
+TEST(StudyNetwork, ExternalMasterFiguresAreReadFromEcmasterJson) {
+  // What `ecmaster --json cyclic` prints on stdout (tools/ecmaster/commands_cyclic.cpp), after
+  // a line of other output; ecmaster gives no p50.
+  const std::string out =
+      "some banner\n"
+      "{\"cycles\": 915, \"cycleTimeUs\": 1000,\n"
+      " \"roundTripUs\": {\"min\": 80.5, \"mean\": 120.0, \"max\": 1570.251, \"p99\": 204.799},\n"
+      " \"jitterUs\": {\"max\": 8736.218, \"p99\": 3866.623}, \"framesLost\": 0,\n"
+      " \"framesLate\": 1, \"overruns\": 29, \"wkcErrors\": 0}\n";
+  const MeasuredCycle m = parseMasterJson(out, kNsPerMs);
+  EXPECT_EQ(m.cycles, 915u);
+  EXPECT_EQ(m.rttP50, -1);
+  EXPECT_EQ(m.rttP99, 204'799);
+  EXPECT_EQ(m.rttMax, 1'570'251);
+  EXPECT_EQ(m.jitterP99, 3'866'623);
+  EXPECT_EQ(m.late, 1u);
+  EXPECT_EQ(m.overruns, 29u);
+  EXPECT_EQ(externalCsvRow(1000, m), "1000,0,915,,204.799,1570.251,,3866.623,8736.218,0,1,29,0");
+  const MeasuredCycle none = parseMasterJson("No slaves found!\n", kNsPerMs);
+  EXPECT_EQ(none.cycles, 0u);
+  EXPECT_EQ(none.rttP99, -1);
+  NetworkModel model;
+  EXPECT_NE(gnuplotScript(model, {1000}, true, true).find("'external.csv' using 1:5"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace ecsim::tools::study

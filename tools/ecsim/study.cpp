@@ -192,6 +192,10 @@ CommandRunner addStudyCommand(CLI::App& app) {
   latency->add_flag("--no-measure", opts->noMeasure,
                     "Model only: no veth measurement (needs no privileges)");
   latency->add_flag("!--no-dc", opts->network.dc, "Do not use distributed clocks");
+  latency->add_option("--master-command", opts->network.masterCommand,
+                      "Also measure this master, per candidate, in the namespace ({iface}, "
+                      "{netns}, {cycle_us}, {seconds} replaced; `ecmaster --json cyclic` output "
+                      "read)");
   latency->add_option("--processing-ns", opts->processingNs, "ESC processing delay");
   latency->add_option("--forwarding-ns", opts->forwardingNs, "ESC forwarding delay");
   latency->add_option("--cable", opts->cableMetres, "Cable length between slaves in metres");

@@ -29,6 +29,8 @@ namespace {
 constexpr auto kServerStartTimeout = std::chrono::seconds(20);
 constexpr int kMasterPriority = 50;  // SCHED_FIFO, below ecsim serve --rt's server
 constexpr SimTime kProgressEvery = 250 * kNsPerMs;
+// An external master may take this long beyond its cycles (scan, bring-up, stop).
+constexpr std::chrono::seconds kExternalGrace{60};
 
 std::string readWhole(const std::filesystem::path& p) {
   std::ifstream in(p);
@@ -121,30 +123,19 @@ Result<MeasuredCycle> runCandidate(master::Master& m, master::Bus& bus, double c
   return r;
 }
 
-}  // namespace
-
-Result<std::vector<MeasuredCycle>> measureNetwork(const NetworkStudyOptions& o,
-                                                  const NetworkModel& model, Progress& progress) {
-  ECSIM_TRY(checkNetworkCapabilities());
-  SignalFlag stop;
-  std::filesystem::create_directories(o.out);
-  const auto log = std::filesystem::path(o.out) / "serve.log";
-  progress.update("measuring: creating a veth pair in a private network namespace", true);
-  ECSIM_ASSIGN_OR_RETURN(VethNamespace ns, VethNamespace::create());
-  const std::string ecsim = o.ecsimBinary.empty()
-                                ? std::filesystem::read_symlink("/proc/self/exe").string()
-                                : o.ecsimBinary;
-  std::vector<std::string> argv{ecsim,   "serve",  "--paced", "--rt",
-                                "--iface", ns.simulatorInterface()};
-  if (!o.esiDir.empty()) {
-    argv.push_back("--esi-dir");
-    argv.push_back(o.esiDir);
+std::string substitute(std::string text, std::string_view key, const std::string& value) {
+  for (std::size_t at = text.find(key); at != std::string::npos;
+       at = text.find(key, at + value.size())) {
+    text.replace(at, key.size(), value);
   }
-  argv.push_back(std::filesystem::absolute(o.topology).string());
-  ECSIM_ASSIGN_OR_RETURN(ChildProcess server,
-                         ns.spawn(argv, SpawnOptions{log.string(), log.string()}));
-  ECSIM_TRY(waitForServer(log, server, stop));
+  return text;
+}
 
+// Our master: brought to OP once, every candidate, back to INIT. Its socket is closed on return.
+Result<std::vector<MeasuredCycle>> measureOurs(const NetworkStudyOptions& o,
+                                               const NetworkModel& model, const VethNamespace& ns,
+                                               const std::filesystem::path& log,
+                                               const SignalFlag& stop, Progress& progress) {
   ECSIM_ASSIGN_OR_RETURN(
       RawSocketLink link,
       RawSocketLink::open(ns.masterInterface(), RawSocketOptions{ns.name(), true}));
@@ -180,9 +171,81 @@ Result<std::vector<MeasuredCycle>> measureNetwork(const NetworkStudyOptions& o,
     measured.push_back(r);
   }
   (void)m.stop();
+  return measured;
+}
+
+// The external master, once per candidate; its output in DIR/external-CYCLE.out and .err.
+Result<std::vector<MeasuredCycle>> measureExternal(const NetworkStudyOptions& o,
+                                                   const VethNamespace& ns,
+                                                   const SignalFlag& stop, Progress& progress) {
+  std::vector<MeasuredCycle> measured;
+  for (double c : o.cyclesUs) {
+    std::string command = substitute(o.masterCommand, "{iface}", ns.masterInterface());
+    command = substitute(command, "{netns}", ns.name());
+    command = substitute(command, "{cycle_us}", fmt::format("{:g}", c));
+    command = substitute(command, "{seconds}", fmt::format("{:g}", o.measureSeconds));
+    const auto base = std::filesystem::path(o.out) / fmt::format("external-{:g}", c);
+    progress.update(fmt::format("external master at {:g} us: {}", c, command), true);
+    ECSIM_ASSIGN_OR_RETURN(
+        ChildProcess child,
+        ns.spawn({"sh", "-c", command},
+                 SpawnOptions{base.string() + ".out", base.string() + ".err"}));
+    const auto limit = std::chrono::duration<double>(o.measureSeconds) + kExternalGrace;
+    const auto until = std::chrono::steady_clock::now() + limit;
+    Result<int> status = makeError(ErrorCode::kTimeout, "still running");
+    while (!stop.raised() && std::chrono::steady_clock::now() < until) {
+      status = child.wait(std::chrono::milliseconds(100));
+      if (status.ok()) break;
+    }
+    if (!status.ok()) {
+      (void)child.stop();
+      if (stop.raised()) return makeError(ErrorCode::kAborted, "interrupted");
+      return makeError(ErrorCode::kTimeout,
+                       fmt::format("the external master at {:g} us ran longer than {:.0f} s: {}",
+                                   c, limit.count(), command));
+    }
+    MeasuredCycle r = parseMasterJson(readWhole(base.string() + ".out"),
+                                      static_cast<SimTime>(c * static_cast<double>(kNsPerUs)));
+    r.exitCode = *status;
+    progress.update(fmt::format("external master at {:g} us: exit {}, {} cycles", c, r.exitCode,
+                                r.cycles),
+                    true);
+    measured.push_back(r);
+  }
+  return measured;
+}
+
+}  // namespace
+
+Result<Measurement> measureNetwork(const NetworkStudyOptions& o, const NetworkModel& model,
+                                   Progress& progress) {
+  ECSIM_TRY(checkNetworkCapabilities());
+  SignalFlag stop;
+  std::filesystem::create_directories(o.out);
+  const auto log = std::filesystem::path(o.out) / "serve.log";
+  progress.update("measuring: creating a veth pair in a private network namespace", true);
+  ECSIM_ASSIGN_OR_RETURN(VethNamespace ns, VethNamespace::create());
+  const std::string ecsim = o.ecsimBinary.empty()
+                                ? std::filesystem::read_symlink("/proc/self/exe").string()
+                                : o.ecsimBinary;
+  std::vector<std::string> argv{ecsim, "serve", "--paced", "--rt", "--iface",
+                                ns.simulatorInterface()};
+  if (!o.esiDir.empty()) {
+    argv.push_back("--esi-dir");
+    argv.push_back(o.esiDir);
+  }
+  argv.push_back(std::filesystem::absolute(o.topology).string());
+  ECSIM_ASSIGN_OR_RETURN(ChildProcess server,
+                         ns.spawn(argv, SpawnOptions{log.string(), log.string()}));
+  ECSIM_TRY(waitForServer(log, server, stop));
+  Measurement result;
+  ECSIM_ASSIGN_OR_RETURN(result.ours, measureOurs(o, model, ns, log, stop, progress));
+  if (!o.masterCommand.empty()) {
+    ECSIM_ASSIGN_OR_RETURN(result.external, measureExternal(o, ns, stop, progress));
+  }
   (void)server.stop();
   ECSIM_TRY(ns.destroy());
-  return measured;
+  return result;
 }
 
 }  // namespace ecsim::tools::study

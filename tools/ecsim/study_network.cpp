@@ -1,6 +1,7 @@
 #include "tools/ecsim/study_network.hpp"
 
 #include <fmt/core.h>
+#include <nlohmann/json.hpp>
 #include <unistd.h>
 
 #include <algorithm>
@@ -179,6 +180,55 @@ SimTime sync0Shift(const NetworkModel& model, const MeasuredCycle* measured) {
   return model.cycle.outputsCompleteNs + (measured ? measured->jitterP99 : 0);
 }
 
+MeasuredCycle parseMasterJson(const std::string& output, SimTime cycleNs) {
+  MeasuredCycle r;
+  r.cycleNs = cycleNs;
+  r.rttP50 = r.rttP99 = r.rttMax = r.jitterP50 = r.jitterP99 = r.jitterMax = -1;
+  // The document is the whole output, or begins at the last line that starts with '{'.
+  auto doc = nlohmann::json::parse(output, nullptr, false);
+  for (std::size_t at = output.rfind("\n{"); doc.is_discarded() && at != std::string::npos;
+       at = at == 0 ? std::string::npos : output.rfind("\n{", at - 1)) {
+    doc = nlohmann::json::parse(output.substr(at + 1), nullptr, false);
+  }
+  if (doc.is_discarded() || !doc.is_object()) return r;
+  const auto micros = [&](const char* group, const char* key, SimTime& into) {
+    if (doc.contains(group) && doc[group].is_object() && doc[group].contains(key) &&
+        doc[group][key].is_number()) {
+      into = static_cast<SimTime>(doc[group][key].get<double>() * 1e3 + 0.5);
+    }
+  };
+  const auto count = [&](const char* key, std::uint64_t& into) {
+    if (doc.contains(key) && doc[key].is_number_unsigned()) into = doc[key].get<std::uint64_t>();
+  };
+  micros("roundTripUs", "p50", r.rttP50);
+  micros("roundTripUs", "p99", r.rttP99);
+  micros("roundTripUs", "max", r.rttMax);
+  micros("jitterUs", "p50", r.jitterP50);
+  micros("jitterUs", "p99", r.jitterP99);
+  micros("jitterUs", "max", r.jitterMax);
+  count("cycles", r.cycles);
+  count("framesLost", r.lost);
+  count("framesLate", r.late);
+  count("overruns", r.overruns);
+  count("wkcErrors", r.wkcErrors);
+  return r;
+}
+
+std::string externalCsvHeader() {
+  return "cycle_us,exit_code,cycles,rtt_p50_us,rtt_p99_us,rtt_max_us,jitter_p50_us,"
+         "jitter_p99_us,jitter_max_us,lost,late,overruns,wkc_errors";
+}
+
+std::string externalCsvRow(double cycleUs, const MeasuredCycle& m) {
+  const auto time = [](SimTime ns) {
+    return ns < 0 ? std::string() : fmt::format("{:.3f}", us(ns));
+  };
+  return fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{}", cycleUs, m.exitCode, m.cycles,
+                     time(m.rttP50), time(m.rttP99), time(m.rttMax), time(m.jitterP50),
+                     time(m.jitterP99), time(m.jitterMax), m.lost, m.late, m.overruns,
+                     m.wkcErrors);
+}
+
 std::string csvHeader() {
   std::string h;
   for (const char* c : kColumns) h += (h.empty() ? "" : ",") + std::string(c);
@@ -203,7 +253,7 @@ std::string csvRow(double cycleUs, const NetworkModel& model, const MeasuredCycl
 }
 
 std::string gnuplotScript(const NetworkModel& model, const std::vector<double>& cyclesUs,
-                          bool measured) {
+                          bool measured, bool external) {
   const auto [lo, hi] = std::minmax_element(cyclesUs.begin(), cyclesUs.end());
   const double xmin = *lo / 1.3;
   const double xmax = *hi * 1.3;
@@ -259,6 +309,12 @@ std::string gnuplotScript(const NetworkModel& model, const std::vector<double>& 
         column("cycle_us"), column("rtt_p50_us"), column("rtt_p99_us"), column("rtt_max_us"),
         column("jitter_p99_us"));
   }
+  if (external) {  // external.csv: rtt_p99_us and rtt_max_us are its columns 5 and 6
+    s += ", \\\n     'external.csv' using 1:5 title 'external master round trip p99' with "
+         "linespoints lw 2 pt 6 lc rgb '#8c564b'"
+         ", \\\n     '' using 1:6 title 'external master round trip max' with linespoints "
+         "lw 1 dt 2 pt 6 lc rgb '#8c564b'";
+  }
   return s + "\n";
 }
 
@@ -284,6 +340,7 @@ int runNetworkStudy(const NetworkStudyOptions& o) {
              "{:.2f} us after the cycle starts\n",
              us(c.roundTripNs), us(c.wireNs), us(c.outputsCompleteNs));
   std::vector<MeasuredCycle> measured;
+  std::vector<MeasuredCycle> external;
   if (o.measure) {
     auto m = measureNetwork(o, *model, progress);
     progress.finish();
@@ -292,7 +349,8 @@ int runNetworkStudy(const NetworkStudyOptions& o) {
                  m.error().message());
       return 1;
     }
-    measured = std::move(m).value();
+    measured = std::move(m->ours);
+    external = std::move(m->external);
   }
   const auto dir = std::filesystem::path(o.out);
   std::filesystem::create_directories(dir);
@@ -317,8 +375,20 @@ int runNetworkStudy(const NetworkStudyOptions& o) {
       }
       fmt::print("\n");
     }
+    if (!external.empty()) {
+      std::ofstream ext(dir / "external.csv");
+      ext << externalCsvHeader() << "\n";
+      for (std::size_t i = 0; i < external.size(); ++i) {
+        ext << externalCsvRow(o.cyclesUs[i], external[i]) << "\n";
+        const auto& e = external[i];
+        fmt::print("{:8g} us: external master exit {}, {} cycles, round trip p99 {} max {} us\n",
+                   o.cyclesUs[i], e.exitCode, e.cycles,
+                   e.rttP99 < 0 ? "-" : fmt::format("{:.1f}", us(e.rttP99)),
+                   e.rttMax < 0 ? "-" : fmt::format("{:.1f}", us(e.rttMax)));
+      }
+    }
     std::ofstream gp(dir / "latency.gp");
-    gp << gnuplotScript(*model, o.cyclesUs, !measured.empty());
+    gp << gnuplotScript(*model, o.cyclesUs, !measured.empty(), !external.empty());
   }
   auto plot = runCommand({"sh", "-c", "cd '" + dir.string() + "' && gnuplot latency.gp"});
   if (!plot.ok() || plot->exitCode != 0) {

@@ -27,6 +27,11 @@ struct NetworkStudyOptions {
   bool measure{true};
   bool dc{true};  // use distributed clocks when a device has them
   std::string ecsimBinary;  // for `ecsim serve` (default: this program)
+  // An external master, run per candidate after ours, in the namespace through `sh -c`, with
+  // {iface} (the master's end of the pair), {netns}, {cycle_us} and {seconds} replaced. Its
+  // standard output is read as `ecmaster --json cyclic` writes it (roundTripUs and jitterUs
+  // with p50/p99/max, cycles, framesLost, framesLate, overruns, wkcErrors; any may be absent).
+  std::string masterCommand;
 };
 
 struct DeviceRow {
@@ -62,7 +67,17 @@ struct MeasuredCycle {
   SimTime rttP50{0}, rttP99{0}, rttMax{0};
   SimTime jitterP50{0}, jitterP99{0}, jitterMax{0};
   std::uint64_t lost{0}, late{0}, overruns{0}, wkcErrors{0};
+  // An external master's figures: what its output gave (-1: not given), its exit status.
+  int exitCode{0};
 };
+
+struct Measurement {
+  std::vector<MeasuredCycle> ours;      // one per candidate
+  std::vector<MeasuredCycle> external;  // one per candidate with --master-command, else none
+};
+
+// An external master's `ecmaster --json`-style output into figures (absent ones -1).
+MeasuredCycle parseMasterJson(const std::string& output, SimTime cycleNs);
 
 // One line of progress on stderr: redrawn in place on a terminal, plain lines otherwise (then
 // only what `important` marks, so a log does not fill with redraws).
@@ -78,12 +93,16 @@ class Progress {
 };
 
 // The measured curve (study_measure.cpp): needs CAP_NET_ADMIN, CAP_NET_RAW, CAP_SYS_ADMIN.
-Result<std::vector<MeasuredCycle>> measureNetwork(const NetworkStudyOptions& options,
+Result<Measurement> measureNetwork(const NetworkStudyOptions& options,
                                                   const NetworkModel& model, Progress& progress);
 
 // The SYNC0 shift a cycle needs after its start: the outputs complete at every slave, later by
 // the master's send jitter (p99) when measured.
 SimTime sync0Shift(const NetworkModel& model, const MeasuredCycle* measured);
+
+// external.csv's header and one row.
+std::string externalCsvHeader();
+std::string externalCsvRow(double cycleUs, const MeasuredCycle& m);
 
 // latency.csv's header and one row (measured: nullptr when not measured).
 std::string csvHeader();
@@ -92,7 +111,7 @@ std::string csvRow(double cycleUs, const NetworkModel& model, const MeasuredCycl
 // latency.gp for the candidates (x range fitted to them, reference lines at 1 ms, 500, 250 and
 // 125 us where they fall inside), with the measured curves when `measured`.
 std::string gnuplotScript(const NetworkModel& model, const std::vector<double>& cyclesUs,
-                          bool measured);
+                          bool measured, bool external = false);
 
 // The whole study; the process exit code (errors printed).
 int runNetworkStudy(const NetworkStudyOptions& options);
