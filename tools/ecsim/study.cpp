@@ -180,7 +180,15 @@ CommandRunner addStudyCommand(CLI::App& app) {
   latency->add_option("--topology", opts->network.topology,
                       "Study this network (topology or ENI file) instead of the sweep: modelled "
                       "and measured round trip, SYNC0 shift and jitter per cycle time")
-      ->check(CLI::ExistingFile);
+      ->check(CLI::Validator(
+          [](std::string& v) -> std::string {
+            if (v == "line" || v == "tree") {
+              return "'" + v + "' is a shape of the sweep: --shape " + v +
+                     " (--topology takes a topology or ENI file)";
+            }
+            return std::filesystem::is_regular_file(v) ? "" : "no such file: " + v;
+          },
+          "FILE"));
   latency->add_option("--esi-dir", opts->network.esiDir, "ESI folder of an ENI's devices");
   latency->add_option("--cycles-us", opts->network.cyclesUs,
                       "Cycle-time candidates in us (with --topology)")
