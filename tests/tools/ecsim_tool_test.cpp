@@ -188,6 +188,27 @@ TEST(EcsimTool, LatencyStudyOfATopologyModelsItWithoutPrivileges) {
   EXPECT_EQ(rows, 2);
   EXPECT_TRUE(std::filesystem::exists(dir / "devices.csv"));
   EXPECT_TRUE(std::filesystem::exists(dir / "latency.png"));
+  // Not a terminal: progress as plain lines, never redrawn.
+  EXPECT_NE(out->output.find("modelling "), std::string::npos) << out->output;
+  EXPECT_EQ(out->output.find('\r'), std::string::npos) << out->output;
+  if (!HasFailure()) std::filesystem::remove_all(dir);
+}
+
+TEST(EcsimTool, LatencyStudyProgressIsOneRedrawnLineOnATerminal) {
+  const auto dir = freshDir("ecsim_study_tty");
+  // script(1) (bsdutils, essential in Debian) runs the command on a pseudo-terminal.
+  auto out = runCommand({"script", "-qec",
+                         kEcsim + " study latency --no-measure --cycles-us 1000 --out " +
+                             dir.string() + " --topology " + std::string(ECSIM_SOURCE_DIR) +
+                             "/examples/topologies/robot6.xml",
+                         "/dev/null"});
+  if (!out.ok()) {
+    if (ciMode()) FAIL() << "script(1) missing under CI=true";
+    GTEST_SKIP() << "script(1) not available";
+  }
+  ASSERT_EQ(out->exitCode, 0) << out->output;
+  EXPECT_NE(out->output.find("\rmodelling "), std::string::npos) << out->output;
+  EXPECT_NE(out->output.find("\x1b[K"), std::string::npos) << out->output;  // rest of line cleared
   if (!HasFailure()) std::filesystem::remove_all(dir);
 }
 
