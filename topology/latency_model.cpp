@@ -35,8 +35,8 @@ SimTime cableNs(double metres, const TimingModel& timing) {
 }  // namespace
 
 SimTime frameWireNs(std::size_t ethernetBytes, const TimingModel& timing, bool gap) {
-  const std::size_t bytes = kPreambleBytes + std::max(ethernetBytes, kMinFrameSize) + kFcsBytes +
-                            (gap ? kGapBytes : 0);
+  const std::size_t bytes =
+      kPreambleBytes + std::max(ethernetBytes, kMinFrameSize) + kFcsBytes + (gap ? kGapBytes : 0);
   return static_cast<SimTime>(bytes) * timing.nsPerByte;
 }
 
@@ -83,7 +83,8 @@ Result<ModelledCycle> modelCycle(Segment& segment, const std::vector<ModelFrame>
     }
     const SimTime ownWire = frameWireNs(*length, timing, false);
     for (SimTime a : arrival) {
-      if (a >= 0) cycle.outputsCompleteNs = std::max(cycle.outputsCompleteNs, a + ownWire - sendTime);
+      if (a >= 0)
+        cycle.outputsCompleteNs = std::max(cycle.outputsCompleteNs, a + ownWire - sendTime);
     }
     cycle.roundTripNs = std::max(cycle.roundTripNs, out.returnTime - sendTime);
     cycle.frameBytes += *length;

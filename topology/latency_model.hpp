@@ -33,7 +33,8 @@ using ModelFrame = std::vector<ModelDatagram>;
 
 struct ModelledCycle {
   std::size_t frames{0};
-  std::size_t frameBytes{0};  // Ethernet bytes of all frames (header to last datagram, padded, no FCS)
+  std::size_t frameBytes{
+      0};  // Ethernet bytes of all frames (header to last datagram, padded, no FCS)
   SimTime wireNs{0};
   SimTime roundTripNs{0};
   SimTime outputsCompleteNs{0};

@@ -171,8 +171,8 @@ TEST(EcsimTool, LatencyStudyWritesCsvScriptAndPlot) {
 TEST(EcsimTool, LatencyStudyOfATopologyModelsItWithoutPrivileges) {
   const auto dir = freshDir("ecsim_study_robot6");
   auto out = runCommand({kEcsim, "study", "latency", "--topology",
-                         std::string(ECSIM_SOURCE_DIR) + "/examples/topologies/robot6.xml",
-                         "--out", dir.string(), "--no-measure", "--cycles-us", "1000,125"});
+                         std::string(ECSIM_SOURCE_DIR) + "/examples/topologies/robot6.xml", "--out",
+                         dir.string(), "--no-measure", "--cycles-us", "1000,125"});
   ASSERT_TRUE(out.ok());
   ASSERT_EQ(out->exitCode, 0) << out->output;
   // robot6: a coupler and six drives of 17 output and 19 input bytes (devices.csv).

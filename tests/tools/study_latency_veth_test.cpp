@@ -30,8 +30,8 @@ TEST(StudyLatencyVeth, Robot6WritesModelledAndMeasuredCurves) {
   const auto dir = std::filesystem::path(::testing::TempDir()) /
                    ("ecsim_study_veth_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
-  auto out = runCommand({kEcsim, "study", "latency", "--topology", kRobot6, "--out",
-                         dir.string(), "--cycles-us", "1000,250", "--measure-seconds", "0.3"});
+  auto out = runCommand({kEcsim, "study", "latency", "--topology", kRobot6, "--out", dir.string(),
+                         "--cycles-us", "1000,250", "--measure-seconds", "0.3"});
   ASSERT_TRUE(out.ok()) << out.error().message();
   ASSERT_EQ(out->exitCode, 0) << out->output;
   std::cout << out->output;  // the measured figures, for the log

@@ -28,14 +28,17 @@ std::filesystem::path writeTopology(const std::string& name, const std::string& 
 // ECS1008 (8 BOOL inputs, SM of 1 byte) then ECS2008 (8 BOOL outputs, 1 byte), both with
 // 1000 ns passages: master -1 m- DI -2 m- DO.
 std::filesystem::path diDo() {
-  return writeTopology(
-      "didO",
-      "  <Master cable=\"1.0\"/>\n"
-      "  <Slave name=\"DI\" esi=\"" + kDevices + "\" product=\"#x00001008\" "
-      "processingDelayNs=\"1000\" forwardingDelayNs=\"1000\"/>\n"
-      "  <Slave name=\"DO\" esi=\"" + kDevices + "\" product=\"#x00002008\" "
-      "processingDelayNs=\"1000\" forwardingDelayNs=\"1000\"/>\n"
-      "  <Link from=\"DI:1\" to=\"DO:0\" cable=\"2.0\"/>\n");
+  return writeTopology("didO",
+                       "  <Master cable=\"1.0\"/>\n"
+                       "  <Slave name=\"DI\" esi=\"" +
+                           kDevices +
+                           "\" product=\"#x00001008\" "
+                           "processingDelayNs=\"1000\" forwardingDelayNs=\"1000\"/>\n"
+                           "  <Slave name=\"DO\" esi=\"" +
+                           kDevices +
+                           "\" product=\"#x00002008\" "
+                           "processingDelayNs=\"1000\" forwardingDelayNs=\"1000\"/>\n"
+                           "  <Link from=\"DI:1\" to=\"DO:0\" cable=\"2.0\"/>\n");
 }
 
 // First bit out and back: 5 + DI 1000 + 10 + DO 1000 + 10 + DI 1000 + 5 ns.
@@ -118,9 +121,8 @@ TEST(StudyNetwork, AnImageLargerThanOneFrameTakesTwoFrames) {
   // The second frame leaves one frame + gap after the first; 45 drives, 1 m cables, 1000 ns
   // passages: 45 processing + 44 forwarding passages, 44 cables twice, the master cable twice.
   const SimTime firstBit = 45 * 1000 + 44 * 1000 + 2 * 44 * 5 + 2 * 5;
-  EXPECT_EQ(model->cycle.roundTripNs,
-            static_cast<SimTime>(8 + bytes[0] + 4 + 12) * 80 + firstBit +
-                static_cast<SimTime>(8 + bytes[1] + 4) * 80);
+  EXPECT_EQ(model->cycle.roundTripNs, static_cast<SimTime>(8 + bytes[0] + 4 + 12) * 80 + firstBit +
+                                          static_cast<SimTime>(8 + bytes[1] + 4) * 80);
 }
 
 TEST(StudyNetwork, AnEniGivesTheSameImageAsTheTopologyOfTheSameNetwork) {
@@ -149,8 +151,7 @@ TEST(StudyNetwork, AFileThatIsNoTopologyIsAnErrorNamingIt) {
   o.topology = writeTopology("bad", "  <Slave name=\"X\" product=\"#x1\" bogus=\"1\"/>\n").string();
   auto model = modelNetwork(o);
   ASSERT_FALSE(model.ok());
-  EXPECT_NE(model.error().message().find(o.topology), std::string::npos)
-      << model.error().message();
+  EXPECT_NE(model.error().message().find(o.topology), std::string::npos) << model.error().message();
 }
 
 TEST(StudyNetwork, CsvRowsCarryModelledAndMeasuredColumns) {

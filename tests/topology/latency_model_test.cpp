@@ -57,15 +57,14 @@ TEST(LatencyModel, SecondFrameLeavesAfterTheFirstOnTheWire) {
   Segment seg;
   twoSlaves(seg);
   // Frame 1: 14 + 2 + 12 + 1400 = 1428 bytes; frame 2: 14 + 2 + 112 + 20 = 148 bytes.
-  auto cycle =
-      modelCycle(seg, {{lrw(0, 1400)}, {lrw(1400, 100), frmwSystemTime()}}, 0, 1.0);
+  auto cycle = modelCycle(seg, {{lrw(0, 1400)}, {lrw(1400, 100), frmwSystemTime()}}, 0, 1.0);
   ASSERT_TRUE(cycle.ok()) << cycle.error().message();
   EXPECT_EQ(cycle->frames, 2u);
   EXPECT_EQ(cycle->frameBytes, 1428u + 148u);
   const SimTime first = (8 + 1428 + 4 + 12) * 80;  // 116,160 ns until frame 2's first bit
   const SimTime secondOwn = (8 + 148 + 4) * 80;    // 12,800 ns
   EXPECT_EQ(cycle->roundTripNs, first + kFirstBitRoundTrip + secondOwn);  // 131,990 ns
-  EXPECT_EQ(cycle->outputsCompleteNs, first + 1015 + secondOwn);         // 129,975 ns
+  EXPECT_EQ(cycle->outputsCompleteNs, first + 1015 + secondOwn);          // 129,975 ns
   EXPECT_EQ(cycle->wireNs, first + (8 + 148 + 4 + 12) * 80);
 }
 

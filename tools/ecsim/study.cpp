@@ -177,9 +177,10 @@ CommandRunner addStudyCommand(CLI::App& app) {
   latency->add_option("--bytes", opts->bytes, "Process-data bytes per slave (in and out)")
       ->delimiter(',');
   latency->add_option("--shape", opts->shapes, "Sweep: line and/or tree")->delimiter(',');
-  latency->add_option("--topology", opts->network.topology,
-                      "Study this network (topology or ENI file) instead of the sweep: modelled "
-                      "and measured round trip, SYNC0 shift and jitter per cycle time")
+  latency
+      ->add_option("--topology", opts->network.topology,
+                   "Study this network (topology or ENI file) instead of the sweep: modelled "
+                   "and measured round trip, SYNC0 shift and jitter per cycle time")
       ->check(CLI::Validator(
           [](std::string& v) -> std::string {
             if (v == "line" || v == "tree") {
@@ -190,12 +191,14 @@ CommandRunner addStudyCommand(CLI::App& app) {
           },
           "FILE"));
   latency->add_option("--esi-dir", opts->network.esiDir, "ESI folder of an ENI's devices");
-  latency->add_option("--cycles-us", opts->network.cyclesUs,
-                      "Cycle-time candidates in us (with --topology)")
+  latency
+      ->add_option("--cycles-us", opts->network.cyclesUs,
+                   "Cycle-time candidates in us (with --topology)")
       ->delimiter(',')
       ->check(CLI::PositiveNumber);
-  latency->add_option("--measure-seconds", opts->network.measureSeconds,
-                      "Measurement per candidate (with --topology)")
+  latency
+      ->add_option("--measure-seconds", opts->network.measureSeconds,
+                   "Measurement per candidate (with --topology)")
       ->check(CLI::Range(0.05, 3600.0));
   latency->add_flag("--no-measure", opts->noMeasure,
                     "Model only: no veth measurement (needs no privileges)");

@@ -20,8 +20,8 @@
 #include "link/raw_socket_link.hpp"
 #include "link/signal_flag.hpp"
 #include "master/master.hpp"
-#include "topology/slave_names.hpp"
 #include "tools/ecsim/study_network.hpp"
+#include "topology/slave_names.hpp"
 
 namespace ecsim::tools::study {
 namespace {
@@ -100,11 +100,12 @@ Result<MeasuredCycle> runCandidate(master::Master& m, master::Bus& bus, double c
     if (bus.now() >= nextProgress) {
       nextProgress += kProgressEvery;
       const auto& st = m.statistics();
-      progress.update(fmt::format("measuring {:g} us: {:.1f}/{:.1f} s, {} cycles, round trip p99 "
-                                  "{:.1f} us, jitter p99 {:.1f} us",
-                                  cycleUs, static_cast<double>(bus.now() - start) / 1e9, seconds,
-                                  r.cycles, static_cast<double>(st.roundTrip.p99()) / 1e3,
-                                  static_cast<double>(st.jitter.p99()) / 1e3));
+      progress.update(
+          fmt::format("measuring {:g} us: {:.1f}/{:.1f} s, {} cycles, round trip p99 "
+                      "{:.1f} us, jitter p99 {:.1f} us",
+                      cycleUs, static_cast<double>(bus.now() - start) / 1e9, seconds, r.cycles,
+                      static_cast<double>(st.roundTrip.p99()) / 1e3,
+                      static_cast<double>(st.jitter.p99()) / 1e3));
     }
     while (bus.now() < next && !stop.raised()) bus.wait(next);
   }
@@ -176,8 +177,8 @@ Result<std::vector<MeasuredCycle>> measureOurs(const NetworkStudyOptions& o,
 
 // The external master, once per candidate; its output in DIR/external-CYCLE.out and .err.
 Result<std::vector<MeasuredCycle>> measureExternal(const NetworkStudyOptions& o,
-                                                   const VethNamespace& ns,
-                                                   const SignalFlag& stop, Progress& progress) {
+                                                   const VethNamespace& ns, const SignalFlag& stop,
+                                                   Progress& progress) {
   std::vector<MeasuredCycle> measured;
   for (double c : o.cyclesUs) {
     std::string command = substitute(o.masterCommand, "{iface}", ns.masterInterface());
@@ -186,10 +187,9 @@ Result<std::vector<MeasuredCycle>> measureExternal(const NetworkStudyOptions& o,
     command = substitute(command, "{seconds}", fmt::format("{:g}", o.measureSeconds));
     const auto base = std::filesystem::path(o.out) / fmt::format("external-{:g}", c);
     progress.update(fmt::format("external master at {:g} us: {}", c, command), true);
-    ECSIM_ASSIGN_OR_RETURN(
-        ChildProcess child,
-        ns.spawn({"sh", "-c", command},
-                 SpawnOptions{base.string() + ".out", base.string() + ".err"}));
+    ECSIM_ASSIGN_OR_RETURN(ChildProcess child,
+                           ns.spawn({"sh", "-c", command},
+                                    SpawnOptions{base.string() + ".out", base.string() + ".err"}));
     const auto limit = std::chrono::duration<double>(o.measureSeconds) + kExternalGrace;
     const auto until = std::chrono::steady_clock::now() + limit;
     Result<int> status = makeError(ErrorCode::kTimeout, "still running");
@@ -201,15 +201,15 @@ Result<std::vector<MeasuredCycle>> measureExternal(const NetworkStudyOptions& o,
       (void)child.stop();
       if (stop.raised()) return makeError(ErrorCode::kAborted, "interrupted");
       return makeError(ErrorCode::kTimeout,
-                       fmt::format("the external master at {:g} us ran longer than {:.0f} s: {}",
-                                   c, limit.count(), command));
+                       fmt::format("the external master at {:g} us ran longer than {:.0f} s: {}", c,
+                                   limit.count(), command));
     }
     MeasuredCycle r = parseMasterJson(readWhole(base.string() + ".out"),
                                       static_cast<SimTime>(c * static_cast<double>(kNsPerUs)));
     r.exitCode = *status;
-    progress.update(fmt::format("external master at {:g} us: exit {}, {} cycles", c, r.exitCode,
-                                r.cycles),
-                    true);
+    progress.update(
+        fmt::format("external master at {:g} us: exit {}, {} cycles", c, r.exitCode, r.cycles),
+        true);
     measured.push_back(r);
   }
   return measured;
@@ -228,8 +228,8 @@ Result<Measurement> measureNetwork(const NetworkStudyOptions& o, const NetworkMo
   const std::string ecsim = o.ecsimBinary.empty()
                                 ? std::filesystem::read_symlink("/proc/self/exe").string()
                                 : o.ecsimBinary;
-  std::vector<std::string> argv{ecsim, "serve", "--paced", "--rt", "--iface",
-                                ns.simulatorInterface()};
+  std::vector<std::string> argv{ecsim,  "serve",   "--paced",
+                                "--rt", "--iface", ns.simulatorInterface()};
   if (!o.esiDir.empty()) {
     argv.push_back("--esi-dir");
     argv.push_back(o.esiDir);

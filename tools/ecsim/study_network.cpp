@@ -1,8 +1,8 @@
 #include "tools/ecsim/study_network.hpp"
 
 #include <fmt/core.h>
-#include <nlohmann/json.hpp>
 #include <unistd.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <array>
@@ -25,13 +25,27 @@ namespace ecsim::tools::study {
 namespace {
 
 // The columns of latency.csv; the plot refers to them by position.
-constexpr std::array<const char*, 21> kColumns{
-    "cycle_us",         "modelled_round_trip_us", "modelled_wire_us", "modelled_min_cycle_us",
-    "outputs_complete_us", "sync0_shift_us",      "model_fits",       "frames_per_cycle",
-    "frame_bytes",      "measured_cycles",        "rtt_p50_us",       "rtt_p99_us",
-    "rtt_max_us",       "jitter_p50_us",          "jitter_p99_us",    "jitter_max_us",
-    "lost",             "late",                   "overruns",         "wkc_errors",
-    "measured_fits"};
+constexpr std::array<const char*, 21> kColumns{"cycle_us",
+                                               "modelled_round_trip_us",
+                                               "modelled_wire_us",
+                                               "modelled_min_cycle_us",
+                                               "outputs_complete_us",
+                                               "sync0_shift_us",
+                                               "model_fits",
+                                               "frames_per_cycle",
+                                               "frame_bytes",
+                                               "measured_cycles",
+                                               "rtt_p50_us",
+                                               "rtt_p99_us",
+                                               "rtt_max_us",
+                                               "jitter_p50_us",
+                                               "jitter_p99_us",
+                                               "jitter_max_us",
+                                               "lost",
+                                               "late",
+                                               "overruns",
+                                               "wkc_errors",
+                                               "measured_fits"};
 
 std::size_t column(std::string_view name) {
   for (std::size_t i = 0; i < kColumns.size(); ++i) {
@@ -73,8 +87,8 @@ std::vector<topology::ModelFrame> cyclicFrames(const master::Master& m) {
   const auto& ref = m.dcSetup().reference;
   if (ref && !ownSystemTime && !frames.empty()) {
     frames.front().push_back(
-        {Command::kFrmw, DatagramHeader::physical(m.slaves()[*ref].station, reg::kSystemTime.address),
-         8});
+        {Command::kFrmw,
+         DatagramHeader::physical(m.slaves()[*ref].station, reg::kSystemTime.address), 8});
   }
   return frames;
 }
@@ -124,12 +138,14 @@ Result<NetworkModel> modelNetwork(const NetworkStudyOptions& o) {
   m.setSlaveNames(topology::slaveNamesInBusOrder(config));
   // An ENI configures the master too: its identities, init commands and cyclic frames.
   if (isEniFile(o.topology)) {
-    if (auto s = m.loadConfig(o.topology); !s.ok()) return inFile(o, "master configuration", s.error());
+    if (auto s = m.loadConfig(o.topology); !s.ok())
+      return inFile(o, "master configuration", s.error());
   }
   if (auto s = m.start(); !s.ok()) return inFile(o, "bringing the network to OP", s.error());
 
   NetworkModel model;
-  model.name = config.name.empty() ? std::filesystem::path(o.topology).stem().string() : config.name;
+  model.name =
+      config.name.empty() ? std::filesystem::path(o.topology).stem().string() : config.name;
   model.outputBytes = m.layout().outputBytes;
   model.inputBytes = m.layout().inputBytes;
   model.frames = cyclicFrames(m);
@@ -152,8 +168,8 @@ Result<NetworkModel> modelNetwork(const NetworkStudyOptions& o) {
     row.dc = p < m.slaves().size() && m.slaves()[p].hasDc();
     model.devices.push_back(std::move(row));
   }
-  auto cycle = topology::modelCycle(seg, model.frames, clock.now() + kNsPerMs,
-                                    config.masterCableMetres);
+  auto cycle =
+      topology::modelCycle(seg, model.frames, clock.now() + kNsPerMs, config.masterCableMetres);
   if (!cycle.ok()) return inFile(o, "modelling the cycle", cycle.error());
   model.cycle = *cycle;
   return model;
@@ -225,8 +241,7 @@ std::string externalCsvRow(double cycleUs, const MeasuredCycle& m) {
   };
   return fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{}", cycleUs, m.exitCode, m.cycles,
                      time(m.rttP50), time(m.rttP99), time(m.rttMax), time(m.jitterP50),
-                     time(m.jitterP99), time(m.jitterMax), m.lost, m.late, m.overruns,
-                     m.wkcErrors);
+                     time(m.jitterP99), time(m.jitterMax), m.lost, m.late, m.overruns, m.wkcErrors);
 }
 
 std::string csvHeader() {
@@ -239,17 +254,17 @@ std::string csvRow(double cycleUs, const NetworkModel& model, const MeasuredCycl
   const auto& c = model.cycle;
   const double shift = us(sync0Shift(model, m));
   const bool modelFits = us(c.minCycleNs()) < cycleUs && us(c.outputsCompleteNs) < cycleUs;
-  std::string row = fmt::format("{},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{},{},{}", cycleUs,
-                                us(c.roundTripNs), us(c.wireNs), us(c.minCycleNs()),
-                                us(c.outputsCompleteNs), shift, modelFits ? "yes" : "no",
-                                c.frames, c.frameBytes);
+  std::string row =
+      fmt::format("{},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{},{},{}", cycleUs, us(c.roundTripNs),
+                  us(c.wireNs), us(c.minCycleNs()), us(c.outputsCompleteNs), shift,
+                  modelFits ? "yes" : "no", c.frames, c.frameBytes);
   if (m == nullptr) return row + ",,,,,,,,,,,,";
   const bool fits = m->cycles > 0 && m->lost == 0 && m->late == 0 && m->wkcErrors == 0 &&
                     m->overruns == 0 && us(m->rttMax) < cycleUs && shift < cycleUs;
   return row + fmt::format(",{},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{},{},{},{},{}",
-                           m->cycles, us(m->rttP50), us(m->rttP99), us(m->rttMax),
-                           us(m->jitterP50), us(m->jitterP99), us(m->jitterMax), m->lost,
-                           m->late, m->overruns, m->wkcErrors, fits ? "yes" : "no");
+                           m->cycles, us(m->rttP50), us(m->rttP99), us(m->rttMax), us(m->jitterP50),
+                           us(m->jitterP99), us(m->jitterMax), m->lost, m->late, m->overruns,
+                           m->wkcErrors, fits ? "yes" : "no");
 }
 
 std::string gnuplotScript(const NetworkModel& model, const std::vector<double>& cyclesUs,
@@ -336,9 +351,10 @@ int runNetworkStudy(const NetworkStudyOptions& o) {
   fmt::print("{}: {} devices, {} output + {} input bytes in {} frame(s) of {} bytes{}\n",
              model->name, model->devices.size(), model->outputBytes, model->inputBytes, c.frames,
              c.frameBytes, model->dc ? ", DC (FRMW of 0x0910 in the first frame)" : ", no DC");
-  fmt::print("modelled: round trip {:.2f} us, wire {:.2f} us, outputs complete at every slave "
-             "{:.2f} us after the cycle starts\n",
-             us(c.roundTripNs), us(c.wireNs), us(c.outputsCompleteNs));
+  fmt::print(
+      "modelled: round trip {:.2f} us, wire {:.2f} us, outputs complete at every slave "
+      "{:.2f} us after the cycle starts\n",
+      us(c.roundTripNs), us(c.wireNs), us(c.outputsCompleteNs));
   std::vector<MeasuredCycle> measured;
   std::vector<MeasuredCycle> external;
   if (o.measure) {
@@ -356,7 +372,8 @@ int runNetworkStudy(const NetworkStudyOptions& o) {
   std::filesystem::create_directories(dir);
   {
     std::ofstream devices(dir / "devices.csv");
-    devices << "position,name,output_bytes,input_bytes,processing_delay_ns,forwarding_delay_ns,dc\n";
+    devices
+        << "position,name,output_bytes,input_bytes,processing_delay_ns,forwarding_delay_ns,dc\n";
     for (const auto& d : model->devices) {
       devices << fmt::format("{},\"{}\",{},{},{},{},{}\n", d.position, d.name, d.outputBytes,
                              d.inputBytes, d.processingNs, d.forwardingNs, d.dc ? "yes" : "no");
@@ -368,10 +385,11 @@ int runNetworkStudy(const NetworkStudyOptions& o) {
       csv << csvRow(o.cyclesUs[i], *model, m) << "\n";
       fmt::print("{:8g} us: SYNC0 shift {:7.2f} us", o.cyclesUs[i], us(sync0Shift(*model, m)));
       if (m != nullptr) {
-        fmt::print(", measured round trip p50 {:.1f} p99 {:.1f} max {:.1f} us, jitter p50 {:.1f} "
-                   "p99 {:.1f} max {:.1f} us, lost {}, late {}, overruns {}",
-                   us(m->rttP50), us(m->rttP99), us(m->rttMax), us(m->jitterP50),
-                   us(m->jitterP99), us(m->jitterMax), m->lost, m->late, m->overruns);
+        fmt::print(
+            ", measured round trip p50 {:.1f} p99 {:.1f} max {:.1f} us, jitter p50 {:.1f} "
+            "p99 {:.1f} max {:.1f} us, lost {}, late {}, overruns {}",
+            us(m->rttP50), us(m->rttP99), us(m->rttMax), us(m->jitterP50), us(m->jitterP99),
+            us(m->jitterMax), m->lost, m->late, m->overruns);
       }
       fmt::print("\n");
     }

@@ -25,7 +25,7 @@ struct NetworkStudyOptions {
   std::vector<double> cyclesUs{2000, 1000, 500, 250, 125, 62.5};
   double measureSeconds{2.0};  // per candidate
   bool measure{true};
-  bool dc{true};  // use distributed clocks when a device has them
+  bool dc{true};            // use distributed clocks when a device has them
   std::string ecsimBinary;  // for `ecsim serve` (default: this program)
   // An external master, run per candidate after ours, in the namespace through `sh -c`, with
   // {iface} (the master's end of the pair), {netns}, {cycle_us} and {seconds} replaced. Its
@@ -93,8 +93,8 @@ class Progress {
 };
 
 // The measured curve (study_measure.cpp): needs CAP_NET_ADMIN, CAP_NET_RAW, CAP_SYS_ADMIN.
-Result<Measurement> measureNetwork(const NetworkStudyOptions& options,
-                                                  const NetworkModel& model, Progress& progress);
+Result<Measurement> measureNetwork(const NetworkStudyOptions& options, const NetworkModel& model,
+                                   Progress& progress);
 
 // The SYNC0 shift a cycle needs after its start: the outputs complete at every slave, later by
 // the master's send jitter (p99) when measured.
