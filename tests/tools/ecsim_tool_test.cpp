@@ -168,6 +168,57 @@ TEST(EcsimTool, LatencyStudyWritesCsvScriptAndPlot) {
   if (!HasFailure()) std::filesystem::remove_all(dir);
 }
 
+TEST(EcsimTool, LatencyStudyOfATopologyModelsItWithoutPrivileges) {
+  const auto dir = freshDir("ecsim_study_robot6");
+  auto out = runCommand({kEcsim, "study", "latency", "--topology",
+                         std::string(ECSIM_SOURCE_DIR) + "/examples/topologies/robot6.xml", "--out",
+                         dir.string(), "--no-measure", "--cycles-us", "1000,125"});
+  ASSERT_TRUE(out.ok());
+  ASSERT_EQ(out->exitCode, 0) << out->output;
+  // robot6: a coupler and six drives of 17 output and 19 input bytes (devices.csv).
+  EXPECT_NE(out->output.find("7 devices, 102 output + 114 input bytes in 1 frame(s)"),
+            std::string::npos)
+      << out->output;
+  std::ifstream csv(dir / "latency.csv");
+  std::string header, row;
+  std::getline(csv, header);
+  EXPECT_EQ(header.rfind("cycle_us,modelled_round_trip_us,", 0), 0u) << header;
+  int rows = 0;
+  while (std::getline(csv, row)) ++rows;
+  EXPECT_EQ(rows, 2);
+  EXPECT_TRUE(std::filesystem::exists(dir / "devices.csv"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "latency.png"));
+  // Not a terminal: progress as plain lines, never redrawn.
+  EXPECT_NE(out->output.find("modelling "), std::string::npos) << out->output;
+  EXPECT_EQ(out->output.find('\r'), std::string::npos) << out->output;
+  if (!HasFailure()) std::filesystem::remove_all(dir);
+}
+
+TEST(EcsimTool, LatencyStudyProgressIsOneRedrawnLineOnATerminal) {
+  const auto dir = freshDir("ecsim_study_tty");
+  // script(1) (bsdutils, essential in Debian) runs the command on a pseudo-terminal.
+  auto out = runCommand({"script", "-qec",
+                         kEcsim + " study latency --no-measure --cycles-us 1000 --out " +
+                             dir.string() + " --topology " + std::string(ECSIM_SOURCE_DIR) +
+                             "/examples/topologies/robot6.xml",
+                         "/dev/null"});
+  if (!out.ok()) {
+    if (ciMode()) FAIL() << "script(1) missing under CI=true";
+    GTEST_SKIP() << "script(1) not available";
+  }
+  ASSERT_EQ(out->exitCode, 0) << out->output;
+  EXPECT_NE(out->output.find("\rmodelling "), std::string::npos) << out->output;
+  EXPECT_NE(out->output.find("\x1b[K"), std::string::npos) << out->output;  // rest of line cleared
+  if (!HasFailure()) std::filesystem::remove_all(dir);
+}
+
+TEST(EcsimTool, LatencyStudyTopologyThatIsAShapeSaysSo) {
+  auto out = runCommand({kEcsim, "study", "latency", "--topology", "line"});
+  ASSERT_TRUE(out.ok());
+  EXPECT_NE(out->exitCode, 0);
+  EXPECT_NE(out->output.find("--shape line"), std::string::npos) << out->output;
+}
+
 TEST(EcsimTool, UnknownTopologyFileIsAClearError) {
   auto out = runCommand({kEcsim, "serve", "/nonexistent/topology.xml", "--iface", "lo"});
   ASSERT_TRUE(out.ok());

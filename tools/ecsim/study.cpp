@@ -1,6 +1,7 @@
 // `ecsim study latency --out DIR`: round trip and minimum cycle per slave count, process-data
-// size and topology, with the simulator's own CPU cost; writes latency.csv, the gnuplot
-// script latency.gp and latency.png.
+// size and shape (line, tree), with the simulator's own CPU cost; writes latency.csv, the
+// gnuplot script latency.gp and latency.png. With --topology FILE the study of that network
+// instead (tools/ecsim/study_network.hpp): modelled and measured, per cycle-time candidate.
 #include <fmt/core.h>
 #include <fmt/ranges.h>
 
@@ -10,6 +11,7 @@
 
 #include "link/netns.hpp"
 #include "tools/ecsim/commands.hpp"
+#include "tools/ecsim/study_network.hpp"
 #include "topology/latency_study.hpp"
 
 namespace ecsim::tools {
@@ -19,11 +21,13 @@ struct StudyOptions {
   std::string out{"latency-study"};
   std::size_t maxSlaves{1024};
   std::vector<unsigned> bytes{1, 8, 32};
-  std::vector<std::string> topologies{"line", "tree"};
+  std::vector<std::string> shapes{"line", "tree"};
   SimTime processingNs{1000};
   SimTime forwardingNs{1000};
   double cableMetres{1.0};
   std::string preset;  // "published": the published EtherCAT figures instead of the sweep
+  study::NetworkStudyOptions network;  // --topology FILE: that network instead of the sweep
+  bool noMeasure{false};
 };
 
 // `--preset published`: each published figure with the network that reproduces it
@@ -74,6 +78,16 @@ set style data linespoints
 )";
 
 int runStudy(const StudyOptions& o) {
+  if (!o.network.topology.empty()) {
+    if (!o.preset.empty()) {
+      fmt::print(stderr, "ecsim study: give either --topology FILE or --preset, not both\n");
+      return 2;
+    }
+    study::NetworkStudyOptions n = o.network;
+    n.out = o.out;
+    n.measure = !o.noMeasure;
+    return study::runNetworkStudy(n);
+  }
   if (o.preset == "published") return runPublished(o);
   if (!o.preset.empty()) {
     fmt::print(stderr, "ecsim study: unknown preset '{}' (published)\n", o.preset);
@@ -86,12 +100,12 @@ int runStudy(const StudyOptions& o) {
          "min_cycle_ns,sim_cpu_ns_per_cycle,closed_form_ns\n";
   RealClock cpu;
   const auto counts = topology::logSpacedCounts(o.maxSlaves);
-  const std::size_t total = counts.size() * o.bytes.size() * o.topologies.size();
+  const std::size_t total = counts.size() * o.bytes.size() * o.shapes.size();
   std::size_t done = 0;
   std::vector<std::string> series;
-  for (const auto& topo : o.topologies) {
+  for (const auto& topo : o.shapes) {
     if (topo != "line" && topo != "tree") {
-      fmt::print(stderr, "ecsim study: unknown topology '{}' (line, tree)\n", topo);
+      fmt::print(stderr, "ecsim study: unknown shape '{}' (line, tree)\n", topo);
       return 2;
     }
     for (unsigned b : o.bytes) {
@@ -131,7 +145,7 @@ int runStudy(const StudyOptions& o) {
   std::ofstream gp(dir / "latency.gp");
   gp << kPlot << "plot ";
   for (std::size_t i = 0; i < series.size(); ++i) {
-    const auto& topo = o.topologies[i / o.bytes.size()];
+    const auto& topo = o.shapes[i / o.bytes.size()];
     const unsigned b = o.bytes[i % o.bytes.size()];
     gp << (i ? ", \\\n     " : "")
        << fmt::format(
@@ -162,7 +176,37 @@ CommandRunner addStudyCommand(CLI::App& app) {
       ->check(CLI::Range(1, 4096));
   latency->add_option("--bytes", opts->bytes, "Process-data bytes per slave (in and out)")
       ->delimiter(',');
-  latency->add_option("--topology", opts->topologies, "line and/or tree")->delimiter(',');
+  latency->add_option("--shape", opts->shapes, "Sweep: line and/or tree")->delimiter(',');
+  latency
+      ->add_option("--topology", opts->network.topology,
+                   "Study this network (topology or ENI file) instead of the sweep: modelled "
+                   "and measured round trip, SYNC0 shift and jitter per cycle time")
+      ->check(CLI::Validator(
+          [](std::string& v) -> std::string {
+            if (v == "line" || v == "tree") {
+              return "'" + v + "' is a shape of the sweep: --shape " + v +
+                     " (--topology takes a topology or ENI file)";
+            }
+            return std::filesystem::is_regular_file(v) ? "" : "no such file: " + v;
+          },
+          "FILE"));
+  latency->add_option("--esi-dir", opts->network.esiDir, "ESI folder of an ENI's devices");
+  latency
+      ->add_option("--cycles-us", opts->network.cyclesUs,
+                   "Cycle-time candidates in us (with --topology)")
+      ->delimiter(',')
+      ->check(CLI::PositiveNumber);
+  latency
+      ->add_option("--measure-seconds", opts->network.measureSeconds,
+                   "Measurement per candidate (with --topology)")
+      ->check(CLI::Range(0.05, 3600.0));
+  latency->add_flag("--no-measure", opts->noMeasure,
+                    "Model only: no veth measurement (needs no privileges)");
+  latency->add_flag("!--no-dc", opts->network.dc, "Do not use distributed clocks");
+  latency->add_option("--master-command", opts->network.masterCommand,
+                      "Also measure this master, per candidate, in the namespace ({iface}, "
+                      "{netns}, {cycle_us}, {seconds} replaced; `ecmaster --json cyclic` output "
+                      "read)");
   latency->add_option("--processing-ns", opts->processingNs, "ESC processing delay");
   latency->add_option("--forwarding-ns", opts->forwardingNs, "ESC forwarding delay");
   latency->add_option("--cable", opts->cableMetres, "Cable length between slaves in metres");
