@@ -59,6 +59,8 @@ class RawSocketLink final : public Link {
   RawSocketLink() = default;
   // Puts back the 802.1Q tag the kernel took off (reported in PACKET_AUXDATA).
   Result<std::size_t> restoreVlanTag(const msghdr& message, Bytes buffer, std::size_t length) const;
+  // SO_RCVTIMEO, set only when it differs from the last one set.
+  Status setReceiveTimeout(std::chrono::nanoseconds timeout);
 
   UniqueFd fd_;
   std::string interface_;
@@ -67,6 +69,7 @@ class RawSocketLink final : public Link {
   MacAddress mac_{};
   bool kernelIgnoresOutgoing_{false};
   std::uint64_t outgoingSkipped_{0};
+  std::chrono::nanoseconds receiveTimeout_{0};  // 0: none set (the socket waits for ever)
 };
 
 }  // namespace ecsim
