@@ -84,6 +84,10 @@ Result<RawSocketLink> RawSocketLink::open(std::string_view interface,
   if (::setsockopt(fd, SOL_PACKET, PACKET_IGNORE_OUTGOING, &one, sizeof one) == 0) {
     link.kernelIgnoresOutgoing_ = true;
   }  // else: older kernel, receive() filters on sll_pkttype
+  if (options.qdiscBypass &&
+      ::setsockopt(fd, SOL_PACKET, PACKET_QDISC_BYPASS, &one, sizeof one) != 0) {
+    return makeError(ErrorCode::kIo, "PACKET_QDISC_BYPASS on " + place + ": " + errnoText(errno));
+  }
   // The kernel takes an 802.1Q tag off a received frame and reports it aside; receive() puts
   // it back, so a tagged request is answered tagged, as a real ESC passes the tag through.
   if (::setsockopt(fd, SOL_PACKET, PACKET_AUXDATA, &one, sizeof one) != 0) {

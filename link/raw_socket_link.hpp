@@ -26,6 +26,11 @@ struct RawSocketOptions {
   // stays there while the calling thread returns to its own namespace. Empty: current one.
   std::string netns;
   bool promiscuous{true};
+  // Send straight to the driver, past the interface's queueing discipline
+  // (PACKET_QDISC_BYPASS): less work per frame, but other packet sockets on this interface
+  // (a capture) do not see the frames sent. `ecsim serve` sets it: its answers are seen
+  // where the master's end receives them.
+  bool qdiscBypass{false};
 };
 
 class RawSocketLink final : public Link {

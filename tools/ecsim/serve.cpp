@@ -87,7 +87,7 @@ int runServe(ServeOptions o) {
   }
   std::unique_ptr<Link> link;
   if (!o.iface.empty()) {
-    auto raw = RawSocketLink::open(o.iface, RawSocketOptions{o.netns, true});
+    auto raw = RawSocketLink::open(o.iface, RawSocketOptions{.netns = o.netns, .promiscuous = true, .qdiscBypass = true});
     if (!raw.ok()) {
       fmt::print(stderr, "ecsim serve: {}\n", raw.error().message());
       return 1;
