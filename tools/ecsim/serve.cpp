@@ -32,6 +32,11 @@
 namespace ecsim::tools {
 namespace {
 
+// While frames come back to back, how often the serve loop looks at its control socket and
+// status and flushes its captures (an action injected through the socket takes effect within
+// this time).
+constexpr SimTime kHousekeepingInterval = kNsPerMs;
+
 struct ServeOptions {
   std::string topology;
   std::string esiDir;  // ESI files for an ENI's devices; empty: the data folder's esi/
@@ -236,12 +241,19 @@ int runServe(ServeOptions o) {
                s.error().message());
     std::fflush(stderr);
   };
+  // The control socket, the status and the captures' flushing are looked after whenever the
+  // server idled, and while frames come back to back at most every kHousekeepingInterval:
+  // not between every two frames, where it cost system calls on the answers' path.
   std::uint64_t receivedBefore = 0;
+  SimTime housekeepingDue = 0;
   auto status = server.run([&] {
-    if (control.ok()) control->poll(handle, clock.now());
-    reporter.tick(clock.now(), segment, server.counters());
     const bool idle = server.counters().framesReceived == receivedBefore;
     receivedBefore = server.counters().framesReceived;
+    const SimTime now = clock.now();
+    if (!idle && now < housekeepingDue) return stop.raised();
+    housekeepingDue = now + kHousekeepingInterval;
+    if (control.ok()) control->poll(handle, now);
+    reporter.tick(now, segment, server.counters());
     for (std::size_t i = 0; i < writers.size(); ++i) {
       reportCapture(taps[i]->status());
       reportCapture(idle ? writers[i]->flush() : writers[i]->flushIfDue(clock.now()));
