@@ -37,6 +37,9 @@ namespace {
 // this time).
 constexpr SimTime kHousekeepingInterval = kNsPerMs;
 
+// ServerOptions::firmwareSpacing of the serve loop.
+constexpr unsigned kFirmwareSpacing = 9;
+
 struct ServeOptions {
   std::string topology;
   std::string esiDir;  // ESI files for an ENI's devices; empty: the data folder's esi/
@@ -203,6 +206,9 @@ int runServe(ServeOptions o) {
   topology::ServerOptions options;
   options.paced = o.paced;
   options.idleWait = std::chrono::milliseconds(10);
+  // Back-to-back frames are answered without waiting for the firmware of every slave; it
+  // takes at most a tenth of the server's time then (docs/timing.md, "Served path").
+  options.firmwareSpacing = kFirmwareSpacing;
   options.malformedObserver = malformedTap;
   topology::NetworkServer server(*served, segment, clock, options);
   SignalFlag stop;
