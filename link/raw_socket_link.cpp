@@ -48,6 +48,7 @@ Result<RawSocketLink> RawSocketLink::open(std::string_view interface,
   RawSocketLink link;
   link.interface_ = std::string(interface);
   link.netns_ = options.netns;
+  link.busyPoll_ = options.busyPoll;
   const std::string place = where(interface, options.netns);
 
   // Protocol 0 at creation: the socket receives nothing until bind() names the interface and
@@ -170,7 +171,8 @@ Result<std::size_t> RawSocketLink::receive(Bytes buffer, std::chrono::nanosecond
   // One blocking recvmsg, bounded by the socket's receive timeout (set again only when the
   // timeout changes): one system call per frame, where trying first and then polling took
   // three while the server idled between frames.
-  const bool wait = timeout > std::chrono::nanoseconds::zero();
+  // Busy-polling: the same recvmsg without waiting, repeated until the deadline.
+  const bool wait = timeout > std::chrono::nanoseconds::zero() && !busyPoll_;
   if (wait) ECSIM_TRY(setReceiveTimeout(timeout));
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   for (;;) {
@@ -189,7 +191,13 @@ Result<std::size_t> RawSocketLink::receive(Bytes buffer, std::chrono::nanosecond
     if (n < 0) {
       // EAGAIN: the receive timeout passed (or nothing waits); EINTR: a signal, so that a
       // loop looks at its SignalFlag (SO_RCVTIMEO waits are never restarted).
-      if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) return std::size_t{0};
+      if (errno == EINTR) return std::size_t{0};
+      if (errno == EAGAIN || errno == EWOULDBLOCK) {
+        if (wait || !busyPoll_ || std::chrono::steady_clock::now() >= deadline) {
+          return std::size_t{0};
+        }
+        continue;
+      }
       return makeError(ErrorCode::kIo, describe() + ": recvmsg: " + errnoText(errno));
     }
     if (n > 0 && from.sll_pkttype != PACKET_OUTGOING &&

@@ -31,6 +31,10 @@ struct RawSocketOptions {
   // (a capture) do not see the frames sent. `ecsim serve` sets it: its answers are seen
   // where the master's end receives them.
   bool qdiscBypass{false};
+  // receive() does not sleep: it asks the socket again and again until a frame is there or
+  // the timeout has passed. No wake-up on the answer's path, at the price of one core kept
+  // busy all the time (for a dedicated core: `ecsim serve --busy-poll`).
+  bool busyPoll{false};
 };
 
 class RawSocketLink final : public Link {
@@ -74,6 +78,7 @@ class RawSocketLink final : public Link {
   MacAddress mac_{};
   bool kernelIgnoresOutgoing_{false};
   std::uint64_t outgoingSkipped_{0};
+  bool busyPoll_{false};
   std::chrono::nanoseconds receiveTimeout_{0};  // 0: none set (the socket waits for ever)
 };
 

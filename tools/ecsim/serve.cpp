@@ -54,6 +54,7 @@ struct ServeOptions {
   bool paced{false};
   bool quiet{false};
   bool realtime{false};
+  bool busyPoll{false};
   bool status{false};      // live table on the terminal
   std::string statusJson;  // status rewritten periodically to this file
   std::string control;     // live-injection socket; empty: /run/ecsim/<interface>.sock
@@ -95,7 +96,7 @@ int runServe(ServeOptions o) {
   }
   std::unique_ptr<Link> link;
   if (!o.iface.empty()) {
-    auto raw = RawSocketLink::open(o.iface, RawSocketOptions{.netns = o.netns, .promiscuous = true, .qdiscBypass = true});
+    auto raw = RawSocketLink::open(o.iface, RawSocketOptions{.netns = o.netns, .promiscuous = true, .qdiscBypass = true, .busyPoll = o.busyPoll});
     if (!raw.ok()) {
       fmt::print(stderr, "ecsim serve: {}\n", raw.error().message());
       return 1;
@@ -307,6 +308,9 @@ CommandRunner addServeCommand(CLI::App& app) {
   cmd->add_flag("--paced", opts->paced, "Answer at the modelled round-trip time");
   cmd->add_flag("--quiet", opts->quiet, "Print only the final statistics");
   cmd->add_flag("--rt", opts->realtime, "Run with SCHED_FIFO priority and locked memory");
+  cmd->add_flag("--busy-poll", opts->busyPoll,
+                "Wait for frames by polling the socket without sleeping: shorter round trips, "
+                "one core kept busy (for a dedicated core)");
   cmd->add_flag("--status", opts->status, "Show a live status table (redrawn twice a second)");
   cmd->add_option("--status-json", opts->statusJson,
                   "Rewrite the status to FILE (JSON) twice a second");
