@@ -219,8 +219,10 @@ int runServe(ServeOptions o) {
     std::fflush(stdout);
   }
   StatusReporter reporter(o.status, o.statusJson);
-  // Live injection (docs/scenarios.md): fault actions as text lines on a Unix socket.
-  topology::FaultInjector faults(network, 1);
+  // Live injection (docs/scenarios.md): fault actions as text lines on a Unix socket. The
+  // injector is made at the first action: as the segment's wire faults it turns off the
+  // replay of the recorded route (docs/timing.md), which a network without faults keeps.
+  std::optional<topology::FaultInjector> faults;
   if (o.control.empty()) {
     o.control = topology::defaultControlSocket(o.iface.empty() ? o.tap : o.iface).string();
   }
@@ -235,7 +237,8 @@ int runServe(ServeOptions o) {
   auto handle = [&](std::string_view line) -> std::string {
     auto action = topology::parseFaultAction(line);
     if (!action.ok()) return "error " + action.error().context;
-    auto done = faults.apply(*action, clock.now());
+    if (!faults) faults.emplace(network, 1);
+    auto done = faults->apply(*action, clock.now());
     return done.ok() ? "ok " + *done : "error " + done.error().context;
   };
   // Captures reach the disk when the server idles and at least every kCaptureFlushInterval
