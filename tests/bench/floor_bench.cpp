@@ -7,9 +7,10 @@
 // `ecsim serve --rt --slaves N`, for each slave count. It prints the median and 99th
 // percentile round trip of each, the difference to the floor, and the cost per slave seen
 // from outside ((difference at N - difference at 1) / (N - 1)) beside the same frame's cost
-// per slave measured in this process (Segment::processFrame, and Segment::pollSlaves, the
-// firmware the server runs between frames). A figure, never a pass/fail on timing: the exit
-// status is 1 only when a responder did not answer, or answered with a wrong working counter.
+// per slave measured in this process (Segment::processFrame with warm caches and with cold
+// ones, and Segment::pollSlaves, the firmware the server runs between frames). A figure,
+// never a pass/fail on timing: the exit status is 1 only when a responder did not answer, or
+// answered with a wrong working counter.
 //
 //   floor_bench [--round-trips N] [--rounds R] [--slaves 1,10,60,250,1000]
 //               [--serve 'NAME=PATH [ARG...]']...
@@ -200,8 +201,13 @@ Result<Figures> measureResponder(const VethNamespace& ns, Client& client,
 // pollSlaves, for a line of n generic slaves.
 struct InProcess {
   double frameNs{0};
+  double coldFrameNs{0};  // each frame after the caches were filled with other data
   double pollNs{0};
 };
+
+// Larger than this machine's caches: writing it evicts what a frame would find cached, as
+// the processes that run while a server sleeps between frames do.
+constexpr std::size_t kEvictBytes = 32u << 20;
 
 InProcess inProcess(unsigned n) {
   topology::Segment seg;
@@ -230,6 +236,16 @@ InProcess inProcess(unsigned n) {
     std::copy(ping.begin(), ping.end(), frame.begin());
     (void)seg.processFrame(frame, static_cast<SimTime>(i) * kNsPerUs);
   });
+  std::vector<std::uint8_t> evict(kEvictBytes);
+  std::vector<double> cold;
+  for (unsigned i = 0; i < 200; ++i) {
+    for (std::size_t at = 0; at < evict.size(); at += 64) evict[at] = static_cast<std::uint8_t>(i);
+    std::copy(ping.begin(), ping.end(), frame.begin());
+    const auto start = Clock::now();
+    (void)seg.processFrame(frame, static_cast<SimTime>(i) * kNsPerUs);
+    cold.push_back(std::chrono::duration<double, std::nano>(Clock::now() - start).count());
+  }
+  r.coldFrameNs = median(cold);
   r.pollNs = timeLoop([&](unsigned i) { seg.pollSlaves(static_cast<SimTime>(i) * kNsPerUs); });
   return r;
 }
@@ -382,16 +398,20 @@ int run(int argc, char** argv) {
     }
   }
   fmt::print("\ncost per slave (outside: (over floor at N - over floor at 1) / (N - 1)):\n");
-  fmt::print("{:>6} {:>16} {:>16}", "slaves", "in-process frame", "in-process poll");
+  fmt::print("{:>6} {:>16} {:>16} {:>16}", "slaves", "in-process frame", "cold caches",
+             "in-process poll");
   for (const auto& s : o.serves) fmt::print(" {:>14} {:>6}", s.name, "ratio");
   fmt::print("\n");
   const InProcess one = inProcess(1);
+  fmt::print("{:>6} {:>13.1f} ns {:>13.1f} ns {:>13.1f} ns   (whole frame, 1 slave)\n", 1,
+             one.frameNs, one.coldFrameNs, one.pollNs);
   for (unsigned n : o.slaves) {
     if (n == 1) continue;
     const InProcess at = inProcess(n);
     const double frame = (at.frameNs - one.frameNs) / (n - 1);
+    const double cold = (at.coldFrameNs - one.coldFrameNs) / (n - 1);
     const double poll = (at.pollNs - one.pollNs) / (n - 1);
-    fmt::print("{:>6} {:>13.1f} ns {:>13.1f} ns", n, frame, poll);
+    fmt::print("{:>6} {:>13.1f} ns {:>13.1f} ns {:>13.1f} ns", n, frame, cold, poll);
     for (const auto& s : o.serves) {
       const double outside = (overhead(s.name, n) - overhead(s.name, 1)) * 1000.0 / (n - 1);
       fmt::print(" {:>11.1f} ns {:>6.2f}", outside, outside / frame);
