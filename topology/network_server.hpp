@@ -75,8 +75,8 @@ class NetworkServer {
   const Clock& clock_;
   ServerOptions options_;
   ServerCounters counters_{};
-  SimTime firmwareDoneAt_{0};   // when the last firmware run ended
-  SimTime firmwareTook_{0};     // how long it took
+  SimTime firmwareDoneAt_{0};    // when the last firmware run ended
+  SimTime firmwareTook_{0};      // how long it took
   bool firmwarePending_{false};  // a run was put off
   std::array<std::uint8_t, kMaxFrameSize> buffer_{};
 };

@@ -90,8 +90,8 @@ std::string loadAverage() {
 
 std::vector<std::uint8_t> pingFrame() {
   std::array<std::uint8_t, kMaxFrameSize> buf{};
-  FrameBuilder b(buf, EthernetHeader{kBroadcastMac, {0x10, 0, 0, 0, 0, 1}, std::nullopt,
-                                     kEtherTypeEtherCat});
+  FrameBuilder b(
+      buf, EthernetHeader{kBroadcastMac, {0x10, 0, 0, 0, 0, 1}, std::nullopt, kEtherTypeEtherCat});
   (void)b.add(Command::kBrd, 0, 0, kPingData);
   auto len = b.finish();
   return {buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(len.ok() ? *len : 0)};
@@ -146,8 +146,8 @@ class Client {
       if (us < 0) {
         ++f.lost;
         if (++lostInARow > kMaxLostInARow) {
-          return makeError(ErrorCode::kTimeout, fmt::format("{} frames in a row unanswered",
-                                                            lostInARow));
+          return makeError(ErrorCode::kTimeout,
+                           fmt::format("{} frames in a row unanswered", lostInARow));
         }
         continue;
       }
@@ -174,9 +174,9 @@ class Client {
 Result<Figures> measureResponder(const VethNamespace& ns, Client& client,
                                  const std::vector<std::string>& argv, std::uint16_t wkc,
                                  unsigned count, const SignalFlag& stop) {
-  const std::string log = (std::filesystem::temp_directory_path() /
-                           fmt::format("ecsim-floor-bench-{}.log", ::getpid()))
-                              .string();
+  const std::string log =
+      (std::filesystem::temp_directory_path() / fmt::format("ecsim-floor-bench-{}.log", ::getpid()))
+          .string();
   ECSIM_ASSIGN_OR_RETURN(auto child, ns.spawn(argv, SpawnOptions{log, log}));
   auto failed = [&](const std::string& what) {
     (void)child.stop();
@@ -184,8 +184,8 @@ Result<Figures> measureResponder(const VethNamespace& ns, Client& client,
     std::stringstream s;
     s << in.rdbuf();
     std::filesystem::remove(log);
-    return makeError(ErrorCode::kIo, fmt::format("{}: {}; its output:\n{}", argv.front(), what,
-                                                 s.str()));
+    return makeError(ErrorCode::kIo,
+                     fmt::format("{}: {}; its output:\n{}", argv.front(), what, s.str()));
   };
   if (!client.waitReady(wkc, std::chrono::seconds(30), stop)) {
     return failed(stop.raised() ? "interrupted" : "no answer within 30 s");
@@ -324,10 +324,11 @@ int run(int argc, char** argv) {
   sched_param param{};
   param.sched_priority = kClientPriority;
   const bool fifo = sched_setscheduler(0, SCHED_FIFO | SCHED_RESET_ON_FORK, &param) == 0;
-  fmt::print("floor_bench: {} round trips per run, {} round(s), 64-byte BRD, client {}; "
-             "load average at start {}\n",
-             o.roundTrips, o.rounds, fifo ? "SCHED_FIFO" : "normal priority (FIFO refused)",
-             loadAverage());
+  fmt::print(
+      "floor_bench: {} round trips per run, {} round(s), 64-byte BRD, client {}; "
+      "load average at start {}\n",
+      o.roundTrips, o.rounds, fifo ? "SCHED_FIFO" : "normal priority (FIFO refused)",
+      loadAverage());
   std::fflush(stdout);
 
   // results[responder][slaves] = one Figures per round; "floor" is the floor responder.
@@ -347,8 +348,8 @@ int run(int argc, char** argv) {
         } else {
           const auto& s = *std::find_if(o.serves.begin(), o.serves.end(),
                                         [&](const auto& x) { return x.name == who; });
-          command = {s.path, "serve", "--iface", ns->simulatorInterface(), "--slaves",
-                  std::to_string(n), "--rt", "--quiet"};
+          command = {s.path,     "serve",           "--iface", ns->simulatorInterface(),
+                     "--slaves", std::to_string(n), "--rt",    "--quiet"};
           command.insert(command.end(), s.args.begin(), s.args.end());
           wkc = static_cast<std::uint16_t>(n);  // BRD: every slave counts once
         }
@@ -359,8 +360,10 @@ int run(int argc, char** argv) {
           return 1;
         }
         results[who][n].push_back(*f);
-        fmt::print(stderr, "round {} slaves {:>5} {:>12}: median {:7.2f} us  p99 {:7.2f} us  "
-                   "lost {}\n", round + 1, n, who, f->medianUs, f->p99Us, f->lost);
+        fmt::print(stderr,
+                   "round {} slaves {:>5} {:>12}: median {:7.2f} us  p99 {:7.2f} us  "
+                   "lost {}\n",
+                   round + 1, n, who, f->medianUs, f->p99Us, f->lost);
       }
     }
   }
@@ -386,8 +389,8 @@ int run(int argc, char** argv) {
   };
   fmt::print("\nround trip, median of {} round(s) (load average now {}):\n", o.rounds,
              loadAverage());
-  fmt::print("{:>6} {:>14} {:>10} {:>10}  {:>14}\n", "slaves", "responder", "median",
-             "p99", "over floor");
+  fmt::print("{:>6} {:>14} {:>10} {:>10}  {:>14}\n", "slaves", "responder", "median", "p99",
+             "over floor");
   for (unsigned n : o.slaves) {
     fmt::print("{:>6} {:>14} {:>7.2f} us {:>7.2f} us\n", n, "floor",
                med("floor", n, &Figures::medianUs), med("floor", n, &Figures::p99Us));

@@ -77,6 +77,11 @@ int runServe(ServeOptions o) {
     fmt::print(stderr, "ecsim serve: give exactly one of --iface, --veth or --tap\n");
     return 2;
   }
+  if (o.busyPoll && !o.tap.empty()) {
+    fmt::print(stderr,
+               "ecsim serve: --busy-poll needs a raw socket (--iface or --veth), not --tap\n");
+    return 2;
+  }
   // --veth NAME: create the pair for the run (cleaning a stale one) and remove it after.
   struct VethGuard {
     std::string name;
@@ -96,7 +101,10 @@ int runServe(ServeOptions o) {
   }
   std::unique_ptr<Link> link;
   if (!o.iface.empty()) {
-    auto raw = RawSocketLink::open(o.iface, RawSocketOptions{.netns = o.netns, .promiscuous = true, .qdiscBypass = true, .busyPoll = o.busyPoll});
+    auto raw = RawSocketLink::open(
+        o.iface,
+        RawSocketOptions{
+            .netns = o.netns, .promiscuous = true, .qdiscBypass = true, .busyPoll = o.busyPoll});
     if (!raw.ok()) {
       fmt::print(stderr, "ecsim serve: {}\n", raw.error().message());
       return 1;
