@@ -26,6 +26,15 @@ struct RawSocketOptions {
   // stays there while the calling thread returns to its own namespace. Empty: current one.
   std::string netns;
   bool promiscuous{true};
+  // Send straight to the driver, past the interface's queueing discipline
+  // (PACKET_QDISC_BYPASS): less work per frame, but other packet sockets on this interface
+  // (a capture) do not see the frames sent. `ecsim serve` sets it: its answers are seen
+  // where the master's end receives them.
+  bool qdiscBypass{false};
+  // receive() does not sleep: it asks the socket again and again until a frame is there or
+  // the timeout has passed. No wake-up on the answer's path, at the price of one core kept
+  // busy all the time (for a dedicated core: `ecsim serve --busy-poll`).
+  bool busyPoll{false};
 };
 
 class RawSocketLink final : public Link {
@@ -59,6 +68,8 @@ class RawSocketLink final : public Link {
   RawSocketLink() = default;
   // Puts back the 802.1Q tag the kernel took off (reported in PACKET_AUXDATA).
   Result<std::size_t> restoreVlanTag(const msghdr& message, Bytes buffer, std::size_t length) const;
+  // SO_RCVTIMEO, set only when it differs from the last one set.
+  Status setReceiveTimeout(std::chrono::nanoseconds timeout);
 
   UniqueFd fd_;
   std::string interface_;
@@ -67,6 +78,8 @@ class RawSocketLink final : public Link {
   MacAddress mac_{};
   bool kernelIgnoresOutgoing_{false};
   std::uint64_t outgoingSkipped_{0};
+  bool busyPoll_{false};
+  std::chrono::nanoseconds receiveTimeout_{0};  // 0: none set (the socket waits for ever)
 };
 
 }  // namespace ecsim

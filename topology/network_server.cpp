@@ -33,16 +33,39 @@ bool NetworkServer::waitUntil(SimTime t, const std::function<bool()>& stop) {
   }
 }
 
+SimTime NetworkServer::firmwareDueAt() const {
+  return firmwareDoneAt_ + static_cast<SimTime>(options_.firmwareSpacing) * firmwareTook_;
+}
+
+void NetworkServer::runFirmware(bool idle) {
+  const SimTime start = clock_.now();
+  if (!idle && options_.firmwareSpacing != 0 && start < firmwareDueAt()) {
+    firmwarePending_ = true;
+    return;
+  }
+  segment_.pollSlaves(start);
+  firmwarePending_ = false;
+  firmwareDoneAt_ = clock_.now();
+  firmwareTook_ = firmwareDoneAt_ - start;
+}
+
 Status NetworkServer::step(const std::function<bool()>& stop) {
-  auto received = link_.receive(buffer_, options_.idleWait);
+  // A firmware run put off: the wait for the next frame ends when it is due, so that the
+  // last frame of a burst is followed by the firmware's reaction as promptly as before.
+  std::chrono::nanoseconds wait = options_.idleWait;
+  if (firmwarePending_) {
+    wait = std::clamp(std::chrono::nanoseconds(firmwareDueAt() - clock_.now()),
+                      std::chrono::nanoseconds::zero(), options_.idleWait);
+  }
+  auto received = link_.receive(buffer_, wait);
   const SimTime now = clock_.now();
   if (!received.ok()) {
     ++counters_.receiveErrors;  // e.g. an oversize frame: dropped by the link
-    segment_.pollSlaves(now);
+    runFirmware(false);
     return okStatus();
   }
   if (*received == 0) {
-    segment_.pollSlaves(now);
+    runFirmware(true);
     return okStatus();
   }
   ++counters_.framesReceived;
@@ -62,7 +85,7 @@ Status NetworkServer::step(const std::function<bool()>& stop) {
   if (options_.paced) {
     if (outcome.returnTime - now > options_.maxPacedWait.count()) {
       ++counters_.framesLate;
-      segment_.pollSlaves(now);
+      runFirmware(false);
       return okStatus();
     }
     if (!waitUntil(outcome.returnTime, stop)) return okStatus();
@@ -73,7 +96,7 @@ Status NetworkServer::step(const std::function<bool()>& stop) {
     ++counters_.framesAnswered;
   }
   // The firmware reacts after the frame has passed, as on hardware.
-  segment_.pollSlaves(clock_.now());
+  runFirmware(false);
   return okStatus();
 }
 

@@ -27,6 +27,15 @@ struct ServerOptions {
   std::chrono::nanoseconds idleWait{std::chrono::milliseconds(1)};
   // Paced mode: the longest an answer is held.
   std::chrono::nanoseconds maxPacedWait{std::chrono::seconds(1)};
+  // The slaves' firmware (Segment::pollSlaves) off the answers' path. 0: it runs after every
+  // frame. N > 0: after a frame it runs only when the time since its last run (on the clock)
+  // is at least N times what that run took, so that while frames come back to back it takes
+  // at most 1/(N+1) of the server's time and most frames find the server waiting for them,
+  // not busy with the firmware (as a real ESC's frame path does not wait for its PDI side).
+  // It always runs when the wait for a frame ends empty, and a run put off ends the wait
+  // for the next frame when it is due. A clock that does not advance while
+  // the firmware runs (virtual time) makes every run due: the same as 0.
+  unsigned firmwareSpacing{0};
   // Sees every malformed frame the server drops, as received, stamped with the clock's time
   // (`ecsim serve --pcap-malformed`). Not owned; null: none.
   CableObserver* malformedObserver{nullptr};
@@ -59,10 +68,16 @@ class NetworkServer {
   Status step(const std::function<bool()>& stop);
   // Paced: holds until `t` on the clock; false when stop() was raised first.
   bool waitUntil(SimTime t, const std::function<bool()>& stop);
+  // Runs the firmware now, or (firmwareSpacing) only when it is due; `idle`: always.
+  void runFirmware(bool idle);
+  SimTime firmwareDueAt() const;
 
   const Clock& clock_;
   ServerOptions options_;
   ServerCounters counters_{};
+  SimTime firmwareDoneAt_{0};    // when the last firmware run ended
+  SimTime firmwareTook_{0};      // how long it took
+  bool firmwarePending_{false};  // a run was put off
   std::array<std::uint8_t, kMaxFrameSize> buffer_{};
 };
 

@@ -154,6 +154,35 @@ TEST_F(RawSocketLinkTest, TimesOutAndRefusesBadFrames) {
   EXPECT_TRUE(master->send(std::vector<std::uint8_t>(kMaxFrameSize, 0)).ok());
 }
 
+// Issue 18: the served path's options. Busy-polling carries frames and still ends an empty
+// wait at its timeout; frames sent past the queueing discipline reach the other end.
+TEST_F(RawSocketLinkTest, BusyPollAndQdiscBypassCarryFramesAndKeepTheTimeout) {
+  auto master = open(ns_->masterInterface());
+  auto sim = RawSocketLink::open(ns_->simulatorInterface(),
+                                 {.netns = ns_->name(), .qdiscBypass = true, .busyPoll = true});
+  ASSERT_TRUE(master.ok() && sim.ok());
+  const auto start = std::chrono::steady_clock::now();
+  auto n = sim->receive(buf_, 20ms);
+  ASSERT_TRUE(n.ok());
+  EXPECT_EQ(*n, 0u);
+  EXPECT_GE(std::chrono::steady_clock::now() - start, 20ms);
+
+  const auto request = etherCatFrame(3);
+  ASSERT_TRUE(master->send(request).ok());
+  n = sim->receive(buf_, 2s);
+  ASSERT_TRUE(n.ok()) << n.error().message();
+  EXPECT_EQ(std::vector<std::uint8_t>(buf_.begin(), buf_.begin() + 60), request);
+
+  const auto reply = etherCatFrame(4);
+  ASSERT_TRUE(sim->send(reply).ok());
+  n = master->receive(buf_, 2s);
+  ASSERT_TRUE(n.ok()) << n.error().message();
+  EXPECT_EQ(std::vector<std::uint8_t>(buf_.begin(), buf_.begin() + 60), reply);
+  n = sim->receive(buf_, 0ms);
+  ASSERT_TRUE(n.ok());
+  EXPECT_EQ(*n, 0u) << "its own frame does not come back";
+}
+
 TEST_F(RawSocketLinkTest, SmallReceiveBufferIsAnError) {
   auto master = open(ns_->masterInterface());
   auto sim = open(ns_->simulatorInterface());

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <optional>
+
 #include "link/memory_link.hpp"
 #include "support/test_network.hpp"
 
@@ -119,6 +121,72 @@ TEST(NetworkServer, PacedWaitEndsWhenStopIsRaised) {
   ASSERT_TRUE(t.server.run([&] { return ++calls > 1; }).ok());  // raised during the wait
   EXPECT_EQ(t.server.counters().framesReceived, 1u);
   EXPECT_EQ(t.server.counters().framesAnswered, 0u) << "the wait ended without answering";
+}
+
+// Issue 18: with ServerOptions::firmwareSpacing, frames that come back to back are answered
+// without running the firmware between them; the run put off follows as soon as the wait for
+// the next frame ends. Observed through the AL state machine, which the firmware runs: an AL
+// control write is acted on (AL status 0x0130 changes) only when the firmware has run (ESC
+// datasheet section I: without device emulation the PDI side, not the ESC, acts on AL
+// control).
+struct FirmwareSpacing {
+  explicit FirmwareSpacing(unsigned spacing) : clock(kNsPerUs) {
+    // With a mailbox: a slave with firmware, no device emulation (test_network.hpp).
+    seg.addSlave(makeSlave("s", 0x100, {}, makeSii(0x0000ABCD, 0x100, 0x1000, 128, 0x1080, 128)));
+    seg.wireLine();
+    topology::ServerOptions options;
+    options.firmwareSpacing = spacing;
+    options.idleWait = std::chrono::milliseconds(2);
+    server.emplace(links.second, seg, clock, options);
+  }
+  void send(Command c, std::uint16_t reg, std::vector<std::uint8_t> data) {
+    std::array<std::uint8_t, kMaxFrameSize> buf{};
+    FrameBuilder b(buf, EthernetHeader{});
+    (void)b.add(c, 1, phys(0, reg), data);
+    EXPECT_TRUE(links.first.send(ConstBytes(buf.data(), *b.finish())).ok());
+  }
+  // The AL status in the answer to a BRD of it.
+  std::uint16_t alStatusAnswer() {
+    std::array<std::uint8_t, kMaxFrameSize> buf{};
+    auto got = links.first.receive(buf, std::chrono::milliseconds(100));
+    EXPECT_TRUE(got.ok() && *got > 0);
+    return readLe16(buf, kEthernetHeaderSize + 2 + 10);
+  }
+  topology::Segment seg;
+  std::pair<MemoryLink, MemoryLink> links = MemoryLink::makePair();
+  SteppingClock clock;  // 1 µs per reading: a firmware run takes time on it
+  std::optional<topology::NetworkServer> server;
+};
+
+TEST(NetworkServer, FirmwareSpacingAnswersBackToBackFramesBeforeTheFirmwareRuns) {
+  const std::uint16_t kPreOp = 0x0002;
+  const std::uint16_t init = 0x0001;
+  std::uint16_t withoutSpacing = 0;
+  {
+    FirmwareSpacing t(0);
+    ASSERT_TRUE(t.server->step().ok());  // idle: the firmware runs once
+    t.send(Command::kBwr, reg::kAlControl.address, le16(kPreOp));
+    t.send(Command::kBrd, reg::kAlStatus.address, le16(0));
+    ASSERT_TRUE(t.server->step().ok());
+    ASSERT_TRUE(t.server->step().ok());
+    std::array<std::uint8_t, kMaxFrameSize> buf{};
+    ASSERT_TRUE(t.links.first.receive(buf, std::chrono::milliseconds(100)).ok());  // the BWR
+    withoutSpacing = t.alStatusAnswer();
+    EXPECT_NE(withoutSpacing, init) << "the firmware ran between the two frames";
+  }
+  FirmwareSpacing t(1000);
+  ASSERT_TRUE(t.server->step().ok());  // idle: the firmware runs once (and takes 1 µs)
+  t.send(Command::kBwr, reg::kAlControl.address, le16(kPreOp));
+  t.send(Command::kBrd, reg::kAlStatus.address, le16(0));
+  ASSERT_TRUE(t.server->step().ok());
+  ASSERT_TRUE(t.server->step().ok());
+  std::array<std::uint8_t, kMaxFrameSize> buf{};
+  ASSERT_TRUE(t.links.first.receive(buf, std::chrono::milliseconds(100)).ok());  // the BWR
+  EXPECT_EQ(t.alStatusAnswer(), init) << "answered before the firmware saw the AL control";
+  ASSERT_TRUE(t.server->step().ok());  // no frame: the run put off happens
+  t.send(Command::kBrd, reg::kAlStatus.address, le16(0));
+  ASSERT_TRUE(t.server->step().ok());
+  EXPECT_EQ(t.alStatusAnswer(), withoutSpacing) << "the firmware has acted on it now";
 }
 
 }  // namespace

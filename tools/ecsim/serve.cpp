@@ -33,6 +33,14 @@
 namespace ecsim::tools {
 namespace {
 
+// While frames come back to back, how often the serve loop looks at its control socket and
+// status and flushes its captures (an action injected through the socket takes effect within
+// this time).
+constexpr SimTime kHousekeepingInterval = kNsPerMs;
+
+// ServerOptions::firmwareSpacing of the serve loop.
+constexpr unsigned kFirmwareSpacing = 9;
+
 struct ServeOptions {
   std::string topology;
   std::string esiDir;  // ESI files for an ENI's devices; empty: the data folder's esi/
@@ -47,6 +55,7 @@ struct ServeOptions {
   bool paced{false};
   bool quiet{false};
   bool realtime{false};
+  bool busyPoll{false};
   bool status{false};      // live table on the terminal
   std::string statusJson;  // status rewritten periodically to this file
   std::string control;     // live-injection socket; empty: /run/ecsim/<interface>.sock
@@ -57,6 +66,11 @@ int runServe(ServeOptions o) {
           static_cast<int>(!o.veth.empty()) !=
       1) {
     fmt::print(stderr, "ecsim serve: give exactly one of --iface, --veth or --tap\n");
+    return 2;
+  }
+  if (o.busyPoll && !o.tap.empty()) {
+    fmt::print(stderr,
+               "ecsim serve: --busy-poll needs a raw socket (--iface or --veth), not --tap\n");
     return 2;
   }
   // --veth NAME: create the pair for the run (cleaning a stale one) and remove it after.
@@ -78,7 +92,10 @@ int runServe(ServeOptions o) {
   }
   std::unique_ptr<Link> link;
   if (!o.iface.empty()) {
-    auto raw = RawSocketLink::open(o.iface, RawSocketOptions{o.netns, true});
+    auto raw = RawSocketLink::open(
+        o.iface,
+        RawSocketOptions{
+            .netns = o.netns, .promiscuous = true, .qdiscBypass = true, .busyPoll = o.busyPoll});
     if (!raw.ok()) {
       fmt::print(stderr, "ecsim serve: {}\n", raw.error().message());
       return 1;
@@ -200,6 +217,9 @@ int runServe(ServeOptions o) {
   topology::ServerOptions options;
   options.paced = o.paced;
   options.idleWait = std::chrono::milliseconds(10);
+  // Back-to-back frames are answered without waiting for the firmware of every slave; it
+  // takes at most a tenth of the server's time then (docs/timing.md, "Served path").
+  options.firmwareSpacing = kFirmwareSpacing;
   options.malformedObserver = malformedTap;
   topology::NetworkServer server(*served, segment, clock, options);
   SignalFlag stop;
@@ -209,8 +229,10 @@ int runServe(ServeOptions o) {
     std::fflush(stdout);
   }
   StatusReporter reporter(o.status, o.statusJson);
-  // Live injection (docs/scenarios.md): fault actions as text lines on a Unix socket.
-  topology::FaultInjector faults(network, 1);
+  // Live injection (docs/scenarios.md): fault actions as text lines on a Unix socket. The
+  // injector is made at the first action: as the segment's wire faults it turns off the
+  // replay of the recorded route (docs/timing.md), which a network without faults keeps.
+  std::optional<topology::FaultInjector> faults;
   if (o.control.empty()) {
     o.control = topology::defaultControlSocket(o.iface.empty() ? o.tap : o.iface).string();
   }
@@ -223,7 +245,8 @@ int runServe(ServeOptions o) {
     std::fflush(stdout);
   }
   auto handle = [&](std::string_view line) -> std::string {
-    return topology::answerFaultLine(faults, line, clock.now());
+    if (!faults) faults.emplace(network, 1);
+    return topology::answerFaultLine(*faults, line, clock.now());
   };
   // Captures reach the disk when the server idles and at least every kCaptureFlushInterval
   // under traffic; a capture error is reported at once and fails the run (it serves on).
@@ -235,12 +258,19 @@ int runServe(ServeOptions o) {
                s.error().message());
     std::fflush(stderr);
   };
+  // The control socket, the status and the captures' flushing are looked after whenever the
+  // server idled, and while frames come back to back at most every kHousekeepingInterval:
+  // not between every two frames, where it cost system calls on the answers' path.
   std::uint64_t receivedBefore = 0;
+  SimTime housekeepingDue = 0;
   auto status = server.run([&] {
-    if (control.ok()) control->poll(handle, clock.now());
-    reporter.tick(clock.now(), segment, server.counters());
     const bool idle = server.counters().framesReceived == receivedBefore;
     receivedBefore = server.counters().framesReceived;
+    const SimTime now = clock.now();
+    if (!idle && now < housekeepingDue) return stop.raised();
+    housekeepingDue = now + kHousekeepingInterval;
+    if (control.ok()) control->poll(handle, now);
+    reporter.tick(now, segment, server.counters());
     for (std::size_t i = 0; i < writers.size(); ++i) {
       reportCapture(taps[i]->status());
       reportCapture(idle ? writers[i]->flush() : writers[i]->flushIfDue(clock.now()));
@@ -288,6 +318,9 @@ CommandRunner addServeCommand(CLI::App& app) {
   cmd->add_flag("--paced", opts->paced, "Answer at the modelled round-trip time");
   cmd->add_flag("--quiet", opts->quiet, "Print only the final statistics");
   cmd->add_flag("--rt", opts->realtime, "Run with SCHED_FIFO priority and locked memory");
+  cmd->add_flag("--busy-poll", opts->busyPoll,
+                "Wait for frames by polling the socket without sleeping: shorter round trips, "
+                "one core kept busy (for a dedicated core)");
   cmd->add_flag("--status", opts->status, "Show a live status table (redrawn twice a second)");
   cmd->add_option("--status-json", opts->statusJson,
                   "Rewrite the status to FILE (JSON) twice a second");

@@ -1,0 +1,432 @@
+// How far `ecsim serve` is above the floor (issue 18). In a private network namespace with one
+// veth pair (VethNamespace), this program talks on the master end as a ping-pong
+// client: one 64-byte BRD frame (60 bytes + FCS; 32 data bytes from 0x0000) in flight, the
+// next sent when the answer is back, on SCHED_FIFO where permitted. On the simulator's end it
+// starts, one after the other and alternating, the floor responder (tests/bench/
+// floor_responder.cpp: receive, bump the working counter, send back; no simulation) and
+// `ecsim serve --rt --slaves N`, for each slave count. It prints the median and 99th
+// percentile round trip of each, the difference to the floor, and the cost per slave seen
+// from outside ((difference at N - difference at 1) / (N - 1)) beside the same frame's cost
+// per slave measured in this process (Segment::processFrame with warm caches and with cold
+// ones, and Segment::pollSlaves, the firmware the server runs between frames). A figure,
+// never a pass/fail on timing: the exit status is 1 only when a responder did not answer, or
+// answered with a wrong working counter.
+//
+//   floor_bench [--round-trips N] [--rounds R] [--slaves 1,10,60,250,1000]
+//               [--serve 'NAME=PATH [ARG...]']...
+//
+// --serve adds an `ecsim` binary to compare (several: e.g. before and after a change, measured
+// in one run); ARGs are added to its `serve` command line. Default: the ecsim of this build.
+// Without network privileges: exit status 77 (a skip for ctest), 1 when CI=true.
+#include <fmt/core.h>
+
+#include <sched.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "link/netns.hpp"
+#include "link/raw_socket_link.hpp"
+#include "link/signal_flag.hpp"
+#include "protocol/frame.hpp"
+#include "slavesim/generic_slave.hpp"
+#include "topology/segment.hpp"
+
+namespace ecsim {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+constexpr std::uint16_t kPingData = 32;  // 14 + 2 + 10 + 32 + 2 = 60 bytes, 64 with the FCS
+constexpr std::size_t kIndexAt = kEthernetHeaderSize + 2 + 1;  // first datagram's index
+constexpr std::size_t kSourceMacAt = 6;
+constexpr std::uint8_t kProcessedBit = 0x02;  // an ESC sets the locally administered bit
+constexpr int kClientPriority = 70;           // below the responders' 80 (`serve --rt`)
+constexpr auto kAnswerWait = std::chrono::milliseconds(200);
+constexpr unsigned kMaxLostInARow = 20;
+constexpr unsigned kWarmUp = 500;
+constexpr int kSkip = 77;
+
+struct Options {
+  unsigned roundTrips{20000};
+  unsigned rounds{3};
+  std::vector<unsigned> slaves{1, 10, 60, 250, 1000};
+  struct Serve {
+    std::string name;
+    std::string path;
+    std::vector<std::string> args;
+  };
+  std::vector<Serve> serves;
+};
+
+struct Figures {
+  double medianUs{0};
+  double p99Us{0};
+  unsigned lost{0};
+};
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+std::string loadAverage() {
+  std::ifstream in("/proc/loadavg");
+  std::string one, five, fifteen;
+  in >> one >> five >> fifteen;
+  return one + " " + five + " " + fifteen;
+}
+
+std::vector<std::uint8_t> pingFrame() {
+  std::array<std::uint8_t, kMaxFrameSize> buf{};
+  FrameBuilder b(
+      buf, EthernetHeader{kBroadcastMac, {0x10, 0, 0, 0, 0, 1}, std::nullopt, kEtherTypeEtherCat});
+  (void)b.add(Command::kBrd, 0, 0, kPingData);
+  auto len = b.finish();
+  return {buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(len.ok() ? *len : 0)};
+}
+
+// The ping-pong client on the master's end of the pair.
+class Client {
+ public:
+  explicit Client(RawSocketLink link) : link_(std::move(link)), frame_(pingFrame()) {
+    samples_.reserve(1 << 16);
+  }
+
+  // One round trip; the time in µs, or a negative value when no answer came in time. An
+  // answer with another working counter than `wkc` is an error.
+  Result<double> roundTrip(std::uint16_t wkc) {
+    frame_[kIndexAt] = ++index_;
+    const auto start = Clock::now();
+    ECSIM_TRY(link_.send(frame_));
+    for (;;) {
+      ECSIM_ASSIGN_OR_RETURN(const std::size_t n, link_.receive(in_, kAnswerWait));
+      const auto now = Clock::now();
+      if (n == frame_.size() && (in_[kSourceMacAt] & kProcessedBit) != 0 &&
+          in_[kIndexAt] == index_) {
+        const std::uint16_t got = readLe16(in_, n - 2);
+        if (got != wkc) {
+          return makeError(ErrorCode::kInvalidArgument,
+                           fmt::format("answer with WKC {}, expected {}", got, wkc));
+        }
+        return std::chrono::duration<double, std::micro>(now - start).count();
+      }
+      if (now - start >= kAnswerWait) return -1.0;
+    }
+  }
+
+  // Waits (up to `limit`) until the responder answers at all.
+  bool waitReady(std::uint16_t wkc, std::chrono::seconds limit, const SignalFlag& stop) {
+    const auto deadline = Clock::now() + limit;
+    while (Clock::now() < deadline && !stop.raised()) {
+      auto r = roundTrip(wkc);
+      if (r.ok() && *r >= 0) return true;
+    }
+    return false;
+  }
+
+  Result<Figures> measure(unsigned count, std::uint16_t wkc, const SignalFlag& stop) {
+    for (unsigned i = 0; i < kWarmUp && !stop.raised(); ++i) ECSIM_TRY(roundTrip(wkc));
+    samples_.clear();
+    Figures f;
+    unsigned lostInARow = 0;
+    while (samples_.size() < count && !stop.raised()) {
+      ECSIM_ASSIGN_OR_RETURN(const double us, roundTrip(wkc));
+      if (us < 0) {
+        ++f.lost;
+        if (++lostInARow > kMaxLostInARow) {
+          return makeError(ErrorCode::kTimeout,
+                           fmt::format("{} frames in a row unanswered", lostInARow));
+        }
+        continue;
+      }
+      lostInARow = 0;
+      samples_.push_back(us);
+    }
+    std::sort(samples_.begin(), samples_.end());
+    if (!samples_.empty()) {
+      f.medianUs = samples_[samples_.size() / 2];
+      f.p99Us = samples_[samples_.size() * 99 / 100];
+    }
+    return f;
+  }
+
+ private:
+  RawSocketLink link_;
+  std::vector<std::uint8_t> frame_;
+  std::array<std::uint8_t, kMaxFrameSize> in_{};
+  std::vector<double> samples_;
+  std::uint8_t index_{0};
+};
+
+// Starts a responder in the namespace, measures it, stops it.
+Result<Figures> measureResponder(const VethNamespace& ns, Client& client,
+                                 const std::vector<std::string>& argv, std::uint16_t wkc,
+                                 unsigned count, const SignalFlag& stop) {
+  const std::string log =
+      (std::filesystem::temp_directory_path() / fmt::format("ecsim-floor-bench-{}.log", ::getpid()))
+          .string();
+  ECSIM_ASSIGN_OR_RETURN(auto child, ns.spawn(argv, SpawnOptions{log, log}));
+  auto failed = [&](const std::string& what) {
+    (void)child.stop();
+    std::ifstream in(log);
+    std::stringstream s;
+    s << in.rdbuf();
+    std::filesystem::remove(log);
+    return makeError(ErrorCode::kIo,
+                     fmt::format("{}: {}; its output:\n{}", argv.front(), what, s.str()));
+  };
+  if (!client.waitReady(wkc, std::chrono::seconds(30), stop)) {
+    return failed(stop.raised() ? "interrupted" : "no answer within 30 s");
+  }
+  auto figures = client.measure(count, wkc, stop);
+  if (!figures.ok()) return failed(figures.error().message());
+  (void)child.stop();
+  std::filesystem::remove(log);
+  return figures;
+}
+
+// The same frame's cost in this process: ns per frame through processFrame, and per
+// pollSlaves, for a line of n generic slaves.
+struct InProcess {
+  double frameNs{0};
+  double coldFrameNs{0};  // each frame after the caches were filled with other data
+  double pollNs{0};
+};
+
+// Larger than this machine's caches: writing it evicts what a frame would find cached, as
+// the processes that run while a server sleeps between frames do.
+constexpr std::size_t kEvictBytes = 32u << 20;
+
+InProcess inProcess(unsigned n) {
+  topology::Segment seg;
+  for (unsigned i = 0; i < n; ++i) {
+    seg.addSlave(slavesim::makeGenericSlave(fmt::format("Slave{}", i + 1), i + 1));
+  }
+  seg.wireLine();
+  const auto ping = pingFrame();
+  std::vector<std::uint8_t> frame(ping);
+  auto timeLoop = [](auto&& body) {
+    std::vector<double> perCall;
+    for (int rep = 0; rep < 5; ++rep) {  // median of 5 runs of ~20 ms
+      unsigned calls = 0;
+      const auto start = Clock::now();
+      auto now = start;
+      while (now - start < std::chrono::milliseconds(20)) {
+        for (int i = 0; i < 16; ++i) body(calls++);
+        now = Clock::now();
+      }
+      perCall.push_back(std::chrono::duration<double, std::nano>(now - start).count() / calls);
+    }
+    return median(perCall);
+  };
+  InProcess r;
+  r.frameNs = timeLoop([&](unsigned i) {
+    std::copy(ping.begin(), ping.end(), frame.begin());
+    (void)seg.processFrame(frame, static_cast<SimTime>(i) * kNsPerUs);
+  });
+  std::vector<std::uint8_t> evict(kEvictBytes);
+  std::vector<double> cold;
+  for (unsigned i = 0; i < 200; ++i) {
+    for (std::size_t at = 0; at < evict.size(); at += 64) evict[at] = static_cast<std::uint8_t>(i);
+    std::copy(ping.begin(), ping.end(), frame.begin());
+    const auto start = Clock::now();
+    (void)seg.processFrame(frame, static_cast<SimTime>(i) * kNsPerUs);
+    cold.push_back(std::chrono::duration<double, std::nano>(Clock::now() - start).count());
+  }
+  r.coldFrameNs = median(cold);
+  r.pollNs = timeLoop([&](unsigned i) { seg.pollSlaves(static_cast<SimTime>(i) * kNsPerUs); });
+  return r;
+}
+
+Result<Options> parse(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (i + 1 >= argc) {
+      return makeError(ErrorCode::kInvalidArgument, "option '" + a + "' wants a value");
+    }
+    const std::string v = argv[++i];
+    if (a == "--round-trips") {
+      o.roundTrips = static_cast<unsigned>(std::max(1, std::atoi(v.c_str())));
+    } else if (a == "--rounds") {
+      o.rounds = static_cast<unsigned>(std::max(1, std::atoi(v.c_str())));
+    } else if (a == "--slaves") {
+      o.slaves.clear();
+      std::stringstream s(v);
+      std::string item;
+      while (std::getline(s, item, ',')) {
+        const int n = std::atoi(item.c_str());
+        if (n < 1 || n > 65535) {
+          return makeError(ErrorCode::kInvalidArgument, "--slaves: '" + item + "' not 1..65535");
+        }
+        o.slaves.push_back(static_cast<unsigned>(n));
+      }
+    } else if (a == "--serve") {
+      std::stringstream s(v);
+      std::string spec;
+      s >> spec;
+      const auto eq = spec.find('=');
+      if (eq == std::string::npos || eq == 0) {
+        return makeError(ErrorCode::kInvalidArgument, "--serve wants 'NAME=PATH [ARG...]'");
+      }
+      Options::Serve serve{spec.substr(0, eq), spec.substr(eq + 1), {}};
+      for (std::string arg; s >> arg;) serve.args.push_back(arg);
+      o.serves.push_back(serve);
+    } else {
+      return makeError(ErrorCode::kInvalidArgument,
+                       "unknown option '" + a + "' (--round-trips, --rounds, --slaves, --serve)");
+    }
+  }
+  if (o.serves.empty()) o.serves.push_back({"serve", ECSIM_BINARY, {}});
+  if (std::find(o.slaves.begin(), o.slaves.end(), 1u) == o.slaves.end()) {
+    o.slaves.insert(o.slaves.begin(), 1);  // the per-slave cost is taken against 1 slave
+  }
+  return o;
+}
+
+int run(int argc, char** argv) {
+  auto parsed = parse(argc, argv);
+  if (!parsed.ok()) {
+    fmt::print(stderr, "floor_bench: {}\n", parsed.error().message());
+    return 2;
+  }
+  const Options& o = *parsed;
+  if (auto caps = checkNetworkCapabilities(); !caps.ok()) {
+    const char* ci = std::getenv("CI");
+    fmt::print(stderr, "floor_bench: needs network privileges: {}\n", caps.error().message());
+    return ci != nullptr && std::string(ci) == "true" ? 1 : kSkip;
+  }
+  SignalFlag stop;
+  auto ns = VethNamespace::create();
+  if (!ns.ok()) {
+    fmt::print(stderr, "floor_bench: {}\n", ns.error().message());
+    return 1;
+  }
+  auto link = RawSocketLink::open(ns->masterInterface(), {ns->name(), true});
+  if (!link.ok()) {
+    fmt::print(stderr, "floor_bench: {}\n", link.error().message());
+    return 1;
+  }
+  Client client(std::move(link).value());
+  // Children start with normal scheduling: `serve --rt` and `floor_responder --rt` set theirs.
+  sched_param param{};
+  param.sched_priority = kClientPriority;
+  const bool fifo = sched_setscheduler(0, SCHED_FIFO | SCHED_RESET_ON_FORK, &param) == 0;
+  fmt::print(
+      "floor_bench: {} round trips per run, {} round(s), 64-byte BRD, client {}; "
+      "load average at start {}\n",
+      o.roundTrips, o.rounds, fifo ? "SCHED_FIFO" : "normal priority (FIFO refused)",
+      loadAverage());
+  std::fflush(stdout);
+
+  // results[responder][slaves] = one Figures per round; "floor" is the floor responder.
+  std::map<std::string, std::map<unsigned, std::vector<Figures>>> results;
+  for (unsigned round = 0; round < o.rounds && !stop.raised(); ++round) {
+    for (unsigned n : o.slaves) {
+      // Alternating: the floor, then each serve; the order turns round every other round.
+      std::vector<std::string> order{"floor"};
+      for (const auto& s : o.serves) order.push_back(s.name);
+      if (round % 2 == 1) std::reverse(order.begin(), order.end());
+      for (const auto& who : order) {
+        if (stop.raised()) break;
+        std::vector<std::string> command;
+        std::uint16_t wkc = 1;
+        if (who == "floor") {
+          command = {ECSIM_FLOOR_RESPONDER, ns->simulatorInterface(), "--rt"};
+        } else {
+          const auto& s = *std::find_if(o.serves.begin(), o.serves.end(),
+                                        [&](const auto& x) { return x.name == who; });
+          command = {s.path,     "serve",           "--iface", ns->simulatorInterface(),
+                     "--slaves", std::to_string(n), "--rt",    "--quiet"};
+          command.insert(command.end(), s.args.begin(), s.args.end());
+          wkc = static_cast<std::uint16_t>(n);  // BRD: every slave counts once
+        }
+        auto f = measureResponder(*ns, client, command, wkc, o.roundTrips, stop);
+        if (!f.ok()) {
+          if (stop.raised()) break;
+          fmt::print(stderr, "floor_bench: {} ({} slaves): {}\n", who, n, f.error().message());
+          return 1;
+        }
+        results[who][n].push_back(*f);
+        fmt::print(stderr,
+                   "round {} slaves {:>5} {:>12}: median {:7.2f} us  p99 {:7.2f} us  "
+                   "lost {}\n",
+                   round + 1, n, who, f->medianUs, f->p99Us, f->lost);
+      }
+    }
+  }
+  if (stop.raised()) {
+    fmt::print(stderr, "floor_bench: interrupted\n");
+    return 1;
+  }
+
+  auto med = [&](const std::string& who, unsigned n, auto field) {
+    std::vector<double> v;
+    for (const auto& f : results[who][n]) v.push_back(f.*field);
+    return median(v);
+  };
+  // The difference to the floor, per round (the floor run beside it), median of rounds.
+  auto overhead = [&](const std::string& who, unsigned n) {
+    std::vector<double> v;
+    const auto& floor = results["floor"][n];
+    const auto& served = results[who][n];
+    for (std::size_t r = 0; r < served.size() && r < floor.size(); ++r) {
+      v.push_back(served[r].medianUs - floor[r].medianUs);
+    }
+    return median(v);
+  };
+  fmt::print("\nround trip, median of {} round(s) (load average now {}):\n", o.rounds,
+             loadAverage());
+  fmt::print("{:>6} {:>14} {:>10} {:>10}  {:>14}\n", "slaves", "responder", "median", "p99",
+             "over floor");
+  for (unsigned n : o.slaves) {
+    fmt::print("{:>6} {:>14} {:>7.2f} us {:>7.2f} us\n", n, "floor",
+               med("floor", n, &Figures::medianUs), med("floor", n, &Figures::p99Us));
+    for (const auto& s : o.serves) {
+      fmt::print("{:>6} {:>14} {:>7.2f} us {:>7.2f} us  {:>+11.2f} us\n", n, s.name,
+                 med(s.name, n, &Figures::medianUs), med(s.name, n, &Figures::p99Us),
+                 overhead(s.name, n));
+    }
+  }
+  fmt::print("\ncost per slave (outside: (over floor at N - over floor at 1) / (N - 1)):\n");
+  fmt::print("{:>6} {:>16} {:>16} {:>16}", "slaves", "in-process frame", "cold caches",
+             "in-process poll");
+  for (const auto& s : o.serves) fmt::print(" {:>14} {:>6}", s.name, "ratio");
+  fmt::print("\n");
+  const InProcess one = inProcess(1);
+  fmt::print("{:>6} {:>13.1f} ns {:>13.1f} ns {:>13.1f} ns   (whole frame, 1 slave)\n", 1,
+             one.frameNs, one.coldFrameNs, one.pollNs);
+  for (unsigned n : o.slaves) {
+    if (n == 1) continue;
+    const InProcess at = inProcess(n);
+    const double frame = (at.frameNs - one.frameNs) / (n - 1);
+    const double cold = (at.coldFrameNs - one.coldFrameNs) / (n - 1);
+    const double poll = (at.pollNs - one.pollNs) / (n - 1);
+    fmt::print("{:>6} {:>13.1f} ns {:>13.1f} ns {:>13.1f} ns", n, frame, cold, poll);
+    for (const auto& s : o.serves) {
+      const double outside = (overhead(s.name, n) - overhead(s.name, 1)) * 1000.0 / (n - 1);
+      fmt::print(" {:>11.1f} ns {:>6.2f}", outside, outside / frame);
+    }
+    fmt::print("\n");
+  }
+  return 0;
+}
+
+}  // namespace
+}  // namespace ecsim
+
+int main(int argc, char** argv) {
+  return ecsim::run(argc, argv);
+}
