@@ -97,14 +97,22 @@ Status CyclicExchange::assemble() {
       }
     }
     if (frames_.empty() && dcReference_ && !dcDatagram_) {
-      auto view = builder.add(Command::kFrmw, 0,
-                              DatagramHeader::physical(*dcReference_, reg::kSystemTime.address),
-                              std::uint16_t{8});
-      if (!view.ok()) return view.takeError();
-      dcDatagram_ = DatagramRef{0, k++, true};
-      dcCommand_ = static_cast<std::uint8_t>(Command::kFrmw);
+      // The first frame, unless the process data fills it (an image of more than one frame):
+      // then the FRMW goes in a frame of its own after the process data's (below).
+      auto added = addDcDistribution(builder, k);
+      if (!added.ok() && added.error().code != ErrorCode::kTooLarge) return added;
     }
     if (k == 0) continue;  // nothing of this frame is sent in this state
+    auto length = builder.finish();
+    if (!length.ok()) return length.takeError();
+    ECSIM_TRY(frame->commit(*length));
+    frames_.push_back(std::move(frame));
+  }
+  if (dcReference_ && !dcDatagram_) {
+    auto frame = std::make_unique<CachedFrame>();
+    FrameBuilder builder(frame->buildBuffer(), ethernet);
+    std::size_t k = 0;
+    ECSIM_TRY(addDcDistribution(builder, k));
     auto length = builder.finish();
     if (!length.ok()) return length.takeError();
     ECSIM_TRY(frame->commit(*length));
@@ -129,6 +137,16 @@ Status CyclicExchange::assemble() {
     if (access.write) add(outputs_, 0, layout.outputBytes);
     if (access.read) add(inputs_, layout.outputBytes, layout.size());
   }
+  return okStatus();
+}
+
+Status CyclicExchange::addDcDistribution(FrameBuilder& builder, std::size_t& k) {
+  auto view = builder.add(Command::kFrmw, 0,
+                          DatagramHeader::physical(*dcReference_, reg::kSystemTime.address),
+                          std::uint16_t{8});
+  if (!view.ok()) return view.takeError();
+  dcDatagram_ = DatagramRef{frames_.size(), k++, true};
+  dcCommand_ = static_cast<std::uint8_t>(Command::kFrmw);
   return okStatus();
 }
 

@@ -150,6 +150,9 @@ class CyclicExchange {
     bool active{true};
   };
   Status assemble();
+  // The FRMW distributing the reference's system time, appended to `builder`'s frame (the
+  // next frame to be kept) as its datagram `k`.
+  Status addDcDistribution(FrameBuilder& builder, std::size_t& k);
   bool isActive(const LogicalDatagram& d) const { return !state_ || d.activeIn(*state_); }
 
   const ProcessImageLayout* layout_{nullptr};

@@ -184,6 +184,45 @@ TEST(CyclicTest, HeldDcDistributionGoesAsANopAndIsNotCounted) {
   EXPECT_EQ(exchange().wkcErrors, 1u);
 }
 
+// With DC the master adds an FRMW of the reference's system time (ESC datasheet section I, 9.1:
+// the reference clock's 0x0910 read and written to the others) to the first frame. A process
+// image that fills that frame (more than one frame's worth of data) left no room for it, and
+// build() failed: "frame would be 1516 bytes" (found by the latency study with 45 drives). It
+// now goes in a frame of its own; every frame stays within 1514 bytes.
+TEST(CyclicTest, DcDistributionGetsAFrameOfItsOwnWhenTheFirstIsFull) {
+  master::ProcessImageLayout layout;
+  layout.logicalBase = 0x10000;
+  master::LogicalDatagram lrw;
+  lrw.command = Command::kLrw;
+  lrw.logicalStart = layout.logicalBase;
+  lrw.length = static_cast<std::uint16_t>(kMaxFrameSize - kEthernetHeaderSize -
+                                          kEtherCatHeaderSize - kDatagramOverhead);
+  lrw.frame = 0;
+  layout.datagrams.push_back(lrw);
+  layout.outputBytes = lrw.length;
+  layout.frameCount = 1;
+  master::CyclicExchange cyclic;
+  cyclic.setDcReference(0x1001);
+  ASSERT_TRUE(cyclic.build(layout, {2, 0, 0, 0, 0, 9}).ok());
+  ASSERT_EQ(cyclic.frameCount(), 2u);
+  std::vector<Command> commands;
+  for (std::size_t f = 0; f < cyclic.frameCount(); ++f) {
+    EXPECT_LE(cyclic.frame(f).tx().size(), kMaxFrameSize);
+    auto frame = ConstEtherCatFrame::parse(cyclic.frame(f).tx());
+    ASSERT_TRUE(frame.ok());
+    for (auto d : *frame) commands.push_back(d.command());
+  }
+  EXPECT_EQ(commands, (std::vector<Command>{Command::kLrw, Command::kFrmw}));
+
+  // With room in the first frame, the FRMW rides in it: one frame.
+  layout.datagrams[0].length = 100;
+  layout.outputBytes = 100;
+  master::CyclicExchange small;
+  small.setDcReference(0x1001);
+  ASSERT_TRUE(small.build(layout, {2, 0, 0, 0, 0, 9}).ok());
+  EXPECT_EQ(small.frameCount(), 1u);
+}
+
 TEST(CyclicTest, CounterCatchesAnAllocation) {
   // The counting itself works (so the test above can fail).
   gAllocations = 0;
