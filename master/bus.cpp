@@ -38,8 +38,17 @@ void RealTimeBus::wait(SimTime deadline) {
 
 void VirtualBus::wait(SimTime deadline) {
   const SimTime now = clock_.now();
-  if (auto roundTrip = peer_(now)) {
-    clock_.advance(std::max<SimTime>(1, *roundTrip));
+  // Every frame waiting went out together and travels the network at the same time (frames
+  // follow each other through a line, they do not wait for each other's round trip): all are
+  // served, and the clock moves to the latest return.
+  SimTime latest = 0;
+  bool served = false;
+  while (auto roundTrip = peer_(now)) {
+    latest = std::max(latest, *roundTrip);
+    served = true;
+  }
+  if (served) {
+    clock_.advance(std::max<SimTime>(1, latest));
     return;
   }
   if (deadline > now) {

@@ -6,8 +6,9 @@
 //   RealTimeBus  a real clock; waiting means sleeping on the link's file descriptor until a
 //                frame arrives or the next deadline (for RawSocketLink on an interface);
 //   VirtualBus   a VirtualClock; waiting means letting the network at the other end of the
-//                link serve what we sent (for an in-process simulator: one NetworkServer
-//                step) and moving the clock by the round trip it reports, or to the deadline
+//                link serve every frame we sent (for an in-process simulator: NetworkServer
+//                steps) and moving the clock by the longest round trip it reports (frames in
+//                flight together pass the slaves together, as on a wire), or to the deadline
 //                when nothing was waiting.
 //
 // The same master code therefore runs against MemoryLink + an in-process simulator on
@@ -48,6 +49,7 @@ class VirtualBus final : public Bus {
  public:
   // Serves at most one frame waiting at the far end of the link at time `now` and returns
   // its round trip, or nullopt when nothing was waiting (the peer may still run its firmware).
+  // wait() calls it until nothing is waiting.
   using Peer = std::function<std::optional<SimTime>(SimTime now)>;
 
   VirtualBus(VirtualClock& clock, Peer peer) : clock_(clock), peer_(std::move(peer)) {}

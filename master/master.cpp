@@ -124,7 +124,9 @@ Status Master::scan() {
   (void)cyclic_.build(layout_, options_.transport.source);
   ScanTask task(transport_, slaves_, options_.scan);
   task.start(bus_.now());
-  ECSIM_TRY(run(task, options_.scanTimeout, "scan"));
+  const Status ran = run(task, options_.scanTimeout, "scan");
+  timeoutAdvice_ = task.timeoutAdvice();
+  ECSIM_TRY(ran);
   ECSIM_TRY(task.status());
   applySlaveNames();
   return okStatus();
@@ -193,7 +195,7 @@ Status Master::requestState(AlState target) {
     CyclingTask cycling(task, cyclic_, transport_, image_, options_.cycleTime);
     ran = run(cycling, timeout, "state change");
     CycleWait wait(cyclic_);
-    ECSIM_TRY(run(wait, 4 * options_.transport.timeout, "last cycle"));
+    ECSIM_TRY(run(wait, 4 * transport_.options().timeout, "last cycle"));
     if (!cyclic_.pending()) (void)cyclic_.finish(image_);
   } else {
     ran = run(task, timeout, "state change");
@@ -341,7 +343,7 @@ Status Master::exchange() {
   failedSinceControl_.reset();  // the blocking path: control() looks at this cycle only
   ECSIM_TRY(sendCycle(bus_.now()));
   CycleWait wait(cyclic_);
-  ECSIM_TRY(run(wait, 4 * options_.transport.timeout, "cycle"));
+  ECSIM_TRY(run(wait, 4 * transport_.options().timeout, "cycle"));
   return finishCycle();
 }
 

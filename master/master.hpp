@@ -169,6 +169,8 @@ class Master {
   Status writeRegisters(std::size_t position, std::uint16_t address, ConstBytes data);
 
   const std::vector<SlaveInfo>& slaves() const { return slaves_; }
+  // What the last scan's count said about the frame timeout (ScanOptions::adaptTimeout).
+  const std::optional<TimeoutAdvice>& timeoutAdvice() const { return timeoutAdvice_; }
   const std::vector<SlaveProcessData>& processData() const { return processData_; }
   const ProcessImageLayout& layout() const { return layout_; }
   ConstBytes image() const { return image_; }
@@ -210,6 +212,7 @@ class Master {
   std::vector<VariableInfo> variables_;
   std::vector<MasterEvent> noEvents_;
   DcSetup dc_;
+  std::optional<TimeoutAdvice> timeoutAdvice_;
   std::optional<AlState> initCmdsDoneFor_;  // the before-phase already ran for this target
   std::vector<char> transitionFrom_;        // per slave: the state letter it left
 };

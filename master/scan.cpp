@@ -101,6 +101,7 @@ void ScanTask::start(SimTime /*now*/) {
   readers_.clear();
   batch_.clear();
   status_ = okStatus();
+  advice_.reset();
   count_.read(Command::kBrd, 0, reg::kType, reg::kRevision, 0);
   transport_.queue(count_);
   state_ = State::kCount;
@@ -119,6 +120,23 @@ std::optional<SimTime> ScanTask::wakeAt() const {
     if (t && (!earliest || *t < *earliest)) earliest = t;
   }
   return earliest;
+}
+
+void ScanTask::adviseTimeout() {
+  TimeoutAdvice advice;
+  advice.slaves = slaves_.size();
+  advice.roundTrip = count_.receivedAt() - count_.sentAt();
+  // ESCs pass a frame on as its bits arrive: a full-size frame takes as long as the count
+  // frame through the slaves and then its extra length on the wire (docs/timing.md).
+  const SimTime extra = static_cast<SimTime>(kMaxFrameSize - kMinFrameSize) * kNsPerByte100Mbit;
+  advice.needed = static_cast<SimTime>(options_.timeoutMargin *
+                                       static_cast<double>(advice.roundTrip + extra));
+  advice.before = transport_.options().timeout;
+  if (options_.adaptTimeout && advice.needed > advice.before) {
+    transport_.setTimeout(advice.needed);
+    advice.raised = true;
+  }
+  advice_ = advice;
 }
 
 void ScanTask::queueDefaults() {
@@ -237,6 +255,7 @@ bool ScanTask::step(SimTime now) {
                                   count_.check().error().context));
       }
       slaves_.resize(count_.wkc());
+      adviseTimeout();
       for (std::size_t i = 0; i < slaves_.size(); ++i) {
         slaves_[i].position = i;
         slaves_[i].station = static_cast<std::uint16_t>(options_.firstStation + i);

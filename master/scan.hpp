@@ -32,6 +32,22 @@ struct ScanOptions {
   bool resetToDefaults{true};
   bool readSii{true};
   SiiReaderOptions sii;
+  // The frame timeout this network needs, known once the slaves are counted: timeoutMargin
+  // times the count frame's measured round trip plus the wire time a full-size frame takes
+  // beyond the count frame (ESCs forward as the bits arrive, so only the frame's length adds;
+  // docs/timing.md). With adaptTimeout the transport's timeout is raised to it when shorter
+  // (before the scan's own per-slave frames); ScanTask::timeoutAdvice() says it either way.
+  bool adaptTimeout{true};
+  double timeoutMargin{2.0};
+};
+
+// What the count told about the frame timeout (ScanOptions::adaptTimeout).
+struct TimeoutAdvice {
+  std::size_t slaves{0};
+  SimTime roundTrip{0};  // of the count frame, measured
+  SimTime needed{0};     // timeoutMargin x (roundTrip + a full frame's extra wire time)
+  SimTime before{0};     // the transport's timeout when the count came back
+  bool raised{false};    // the transport's timeout was set to `needed`
 };
 
 class ScanTask final : public Task {
@@ -42,10 +58,13 @@ class ScanTask final : public Task {
   bool step(SimTime now) override;
   std::optional<SimTime> wakeAt() const override;
   const Status& status() const { return status_; }
+  // Set once the slaves are counted.
+  const std::optional<TimeoutAdvice>& timeoutAdvice() const { return advice_; }
 
  private:
   enum class State { kIdle, kCount, kDefaults, kAddresses, kRegisters, kSii, kDone, kFailed };
 
+  void adviseTimeout();
   void queueDefaults();
   void queueAddresses();
   void queueRegisters();
@@ -62,6 +81,7 @@ class ScanTask final : public Task {
   Datagram count_;
   DatagramBatch batch_;
   std::deque<SiiReader> readers_;
+  std::optional<TimeoutAdvice> advice_;
 };
 
 // Each slave's active ports from its DL status, and its parent from the active ports of all

@@ -144,6 +144,8 @@ class Transport {
 
   const TransportCounters& counters() const { return counters_; }
   const TransportOptions& options() const { return options_; }
+  // The per-try timeout of frames sent from now on (the scan raises it for a long network).
+  void setTimeout(SimTime timeout) { options_.timeout = timeout; }
   Link& link() { return link_; }
 
  private:

@@ -17,6 +17,8 @@ constexpr std::size_t kEthernetHeaderSize = 14;
 constexpr std::size_t kVlanTagSize = 4;
 constexpr std::size_t kMaxFrameSize = 1514;  // without FCS (1518 on the wire with FCS)
 constexpr std::size_t kMinFrameSize = 60;    // without FCS (64 with FCS)
+// 100BASE-TX, EtherCAT's speed: a byte takes 80 ns on the wire.
+constexpr std::int64_t kNsPerByte100Mbit = 80;
 
 using MacAddress = std::array<std::uint8_t, 6>;
 

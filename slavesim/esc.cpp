@@ -58,7 +58,7 @@ void Esc::reset() {
   latchReset();       // DC latch unit (esc_latch.cpp), before the event state follows it
   resetEventState();  // AL control mailbox, ECAT event state (esc_events.cpp)
   miiReset();  // esc_mii.cpp
-  loadFromSii();
+  loadFromSii();  // also takes the addressing copies (refreshAddressing)
 }
 
 void Esc::powerOnReset() {
@@ -74,13 +74,18 @@ SimTime Esc::systemTime(SimTime time) const {
 void Esc::processDatagram(DatagramView d, SimTime time) {
   lastWkcIncrement_ = 0;
   now_ = time;
-  localNow_ = dc_.localTime(time);
   orEventsIntoIrq(d);  // the header passes first (esc_events.cpp)
   if (!isKnownCommand(d.rawCommand())) return;  // unknown command: forwarded untouched
   const Command cmd = d.command();
   const std::uint16_t len = d.length();
   std::uint16_t inc = 0;
-  switch (addressMode(cmd)) {
+  const AddressMode mode = addressMode(cmd);
+  if (mode == AddressMode::kConfigured && cmd != Command::kFrmw && d.adp() != stationAddress() &&
+      !(aliasEnabled() && d.adp() == stationAlias())) {
+    return;  // another ESC's datagram: only its header passed (the local clock is not needed)
+  }
+  localNow_ = dc_.localTime(time);
+  switch (mode) {
     case AddressMode::kNone:
       return;
     case AddressMode::kLogical: {
@@ -94,7 +99,6 @@ void Esc::processDatagram(DatagramView d, SimTime time) {
     case AddressMode::kAutoIncrement:
     case AddressMode::kConfigured:
     case AddressMode::kBroadcast: {
-      const AddressMode mode = addressMode(cmd);
       bool addressed;
       if (mode == AddressMode::kAutoIncrement) {
         addressed = d.adp() == 0;
@@ -103,10 +107,7 @@ void Esc::processDatagram(DatagramView d, SimTime time) {
         addressed = true;
         d.setAdp(static_cast<std::uint16_t>(d.adp() + 1));
       } else {
-        std::uint16_t station = reg16(reg::kConfiguredStationAddress.address);
-        bool aliasOn = (memory_[reg::kDlControl.address + 3] & 0x01) != 0;
-        addressed = d.adp() == station ||
-                    (aliasOn && d.adp() == reg16(reg::kConfiguredStationAlias.address));
+        addressed = d.adp() == stationAddress() || (aliasEnabled() && d.adp() == stationAlias());
       }
       const std::uint16_t ado = d.ado();
       const auto end = static_cast<std::uint32_t>(ado) + len;

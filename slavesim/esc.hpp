@@ -57,6 +57,25 @@ class Esc {
   // datagram's first byte passes the processing unit; the ESC reads its own local clock from
   // it. Modifies data, ADP and WKC in place.
   void processDatagram(DatagramView datagram, SimTime time);
+  // What the header of a datagram passing now gets ORed into its IRQ field (the masked ECAT
+  // event request), as processDatagram() does for every datagram, addressed or not.
+  std::uint16_t headerIrq() {
+    if (smEventMask_ != 0) refreshEcatEvents();
+    return ecatIrq_;
+  }
+  // A configured-address datagram (FPRD/FPWR/FPRW) with this ADP is addressed to this ESC: its
+  // station address, or its alias while DL control enables it (0x0103 bit 0). Anything else
+  // such a datagram meets here is only its header passing (headerIrq()).
+  // Asks the cache for the per-frame state (the first two lines of the hot group below).
+  void prefetchFrameState() const {
+    __builtin_prefetch(&dc_);
+    __builtin_prefetch(reinterpret_cast<const char*>(&dc_) + 64);
+  }
+  // Read from copies kept beside the per-frame state (refreshAddressing()), so that a frame
+  // passing ESCs it does not address touches none of their memory.
+  std::uint16_t stationAddress() const { return station_; }
+  bool aliasEnabled() const { return aliasOn_; }
+  std::uint16_t stationAlias() const { return alias_; }
   // Working counter increment this ESC gave the last processed datagram (for tests/tracing).
   std::uint16_t lastWkcIncrement() const { return lastWkcIncrement_; }
   // A new frame starts passing (resets per-frame state: the SyncManagers' end-address rule).
@@ -279,6 +298,16 @@ class Esc {
   std::uint16_t lastWkcIncrement_{0};
   std::uint16_t ecatIrq_{0};      // 0x0210 & 0x0200
   std::uint16_t smEventMask_{0};  // SM bits of 0x0200 (nonzero: SM events are followed)
+  // 0x0010, 0x0012 and 0x0103 bit 0 as in memory_, copied by refreshAddressing() after every
+  // ECAT access, PDI register write, reset and SII load (the only ways they change).
+  std::uint16_t station_{0};
+  std::uint16_t alias_{0};
+  bool aliasOn_{false};
+  void refreshAddressing() {
+    station_ = reg16(reg::kConfiguredStationAddress.address);
+    alias_ = reg16(reg::kConfiguredStationAlias.address);
+    aliasOn_ = (memory_[reg::kDlControl.address + 3] & 0x01) != 0;
+  }
   // Per-frame state of the SM rules and invalid frames (esc_sm.cpp).
   bool invalidFrame_{false};
   bool latchArmed_{false};
@@ -362,6 +391,7 @@ class Esc {
   bool implemented(std::uint32_t at, std::uint32_t n) const;
   void rebuildSmCache();
   void afterPdiWrite(std::uint16_t address) {
+    refreshAddressing();
     if (address >= reg::kFmmuBase && address < reg::kFmmuBase + reg::kFmmuSize * reg::kMaxFmmus) {
       rebuildFmmuCache();
     } else if (address >= reg::kSmBase &&

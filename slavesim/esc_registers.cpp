@@ -124,6 +124,10 @@ bool Esc::writeRegisters(std::uint16_t address, ConstBytes data) {
   }
   if (clearRxErrors) std::fill_n(memory_.begin() + reg::kErrorCountersBegin, 0x0C, 0);
   if (clearLostLink) std::fill_n(memory_.begin() + reg::lostLinkCounter(0), 4, 0);
+  if (overlaps(begin, end, reg::kConfiguredStationAddress.address,
+               reg::kDlControl.address + 4 - reg::kConfiguredStationAddress.address)) {
+    refreshAddressing();
+  }
   hooks &= ~1u;  // WriteHook::kNone
   for (unsigned h = 1; hooks != 0 && h < static_cast<unsigned>(WriteHook::kCount); ++h) {
     if ((hooks & (1u << h)) == 0) continue;
@@ -248,6 +252,7 @@ bool Esc::pdiWriteRegisters(std::uint16_t address, ConstBytes data) {
     accepted |= mask != 0;
     memory_[a] = static_cast<std::uint8_t>((memory_[a] & ~mask) | (data[i] & mask));
   }
+  refreshAddressing();
   return accepted;
 }
 

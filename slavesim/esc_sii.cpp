@@ -60,6 +60,7 @@ void Esc::loadFromSii() {
   }
   writeLe16(memory_, reg::kSiiControlStatus.address, status);
   writeLe16(memory_, reg::kDlStatus.address, dl);
+  refreshAddressing();  // the alias (and a reset's zeroed registers)
 }
 
 void Esc::siiCommand(std::uint16_t control) {

@@ -231,13 +231,7 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
   if (routeValid_ && faults_ == nullptr && !anyObserver_) {
     // The wiring, port states and delays have not changed since the route was recorded: the
     // frame reaches the same ESCs in the same order at the same times relative to sendTime.
-    for (const RouteStop& stop : route_) {
-      slavesim::Esc& esc = *escs_[stop.slave];
-      esc.beginFrame();
-      const SimTime t = sendTime + stop.at;
-      for (std::size_t i = 0; i < count; ++i) esc.processDatagram(datagrams_[i], t + leads[i]);
-      if (esc.receiveTimeLatchArmed()) latched_.push_back(stop.slave);
-    }
+    passRoute(count, leads, sendTime);
     for (const std::uint32_t i : latched_) {
       std::array<SimTime, kPortCount> at = routeArrival_[i];
       for (auto& a : at) a += sendTime;

@@ -190,6 +190,19 @@ class Segment {
     SimTime at;  // arrival at port 0
   };
   std::vector<RouteStop> route_;
+  // The recorded route with a frame of `count` datagrams (segment_route.cpp). Each ESC
+  // processes the datagrams that concern it; a configured-address datagram (FPRD/FPWR/FPRW)
+  // is processed only at the ESC it addresses, while the others' event requests still go into
+  // its IRQ field: the same frame and ESC state as processing every datagram at every ESC,
+  // without a cost per datagram and ESC.
+  void passRoute(std::size_t count, const std::array<SimTime, 128>& leads, SimTime sendTime);
+  void passRouteIndexed(std::size_t count, const std::array<SimTime, 128>& leads,
+                        SimTime sendTime);
+  // Scratch of passRouteIndexed, per frame: datagrams every ESC processes, configured-address
+  // datagrams by (ADP, index), and per IRQ bit the ESCs asking for it from datagram k on.
+  std::array<std::uint8_t, 128> everywhere_{};
+  std::array<std::uint32_t, 128> byAddress_{};
+  std::array<std::array<std::int32_t, 129>, 16> irqRuns_{};
   std::vector<std::array<SimTime, kPortCount>> routeArrival_;
   std::vector<std::uint8_t> routeMask_;
   SimTime routeRoundTrip_{0};

@@ -56,6 +56,29 @@ TEST(EcmasterTool, StatesGoesToOpAndReportsEverySlave) {
   EXPECT_NE(bad.output.find("unknown state 'RUNNING'"), std::string::npos) << bad.output;
 }
 
+// Issue 18: a line of 1000 slaves has a round trip above the default 2 ms frame timeout (1000
+// passages of its ESCs out and back); `states OP` failed with "timeout: station addresses".
+// The scan's count measures the round trip and the timeout follows it, saying so; a timeout
+// the user chose is kept, with a warning naming what to set.
+TEST(EcmasterTool, ALongLineGetsAFrameTimeoutFromItsMeasuredRoundTrip) {
+  auto out = run({"--sim-slaves", "1000", "states", "OP"});
+  ASSERT_EQ(out.exitCode, 0) << out.output.substr(0, 2000);
+  EXPECT_NE(out.output.find("ecmaster: frame timeout raised from 2 ms to "), std::string::npos)
+      << out.output.substr(0, 2000);
+  EXPECT_NE(out.output.find("round trip through 1000 slaves was 2."), std::string::npos)
+      << out.output.substr(0, 2000);
+  EXPECT_NE(out.output.find("999  0x13e8  OP"), std::string::npos);
+  auto chosen = run({"--timeout-ms", "2", "--sim-slaves", "1000", "slaves"});
+  EXPECT_NE(chosen.output.find("ecmaster: warning: --timeout-ms 2 is short for this network"),
+            std::string::npos)
+      << chosen.output.substr(0, 2000);
+  EXPECT_EQ(chosen.output.find("frame timeout raised"), std::string::npos);
+  // A short line needs nothing: not a word about timeouts.
+  auto small = run({"--sim-slaves", "10", "slaves"});
+  ASSERT_EQ(small.exitCode, 0) << small.output;
+  EXPECT_EQ(small.output.find("timeout"), std::string::npos) << small.output;
+}
+
 TEST(EcmasterTool, UploadAndDownloadWithTypes) {
   auto out = run({"--sim", kDemo, "upload", "-p", "4", "0x1018:02", "--type", "uint32"});
   ASSERT_EQ(out.exitCode, 0) << out.output;

@@ -21,7 +21,9 @@ struct GlobalOptions {
   std::string config;     // --config FILE: expected slaves (identity check)
   std::string names;      // --names FILE: slave names by bus position (topology or ENI)
   bool checkSerial{false};  // --check-serial: the identity check compares serial numbers too
-  unsigned timeoutMs{2};  // per-frame timeout
+  // --timeout-ms: per-frame timeout; 0 (not given): 2 ms, raised after the scan's count to
+  // what the network needs (master::ScanOptions::adaptTimeout), said on stderr.
+  unsigned timeoutMs{0};
 };
 
 using CommandRunner = std::function<int()>;

@@ -27,12 +27,36 @@ void printJson(const nlohmann::json& value) {
   std::cout << value.dump(2) << "\n";
 }
 
+// Says what the scan's count told about the frame timeout: raised (and to what), or, with
+// --timeout-ms, that it is too short for this network and what to set.
+void reportTimeout(const master::Master& master, const GlobalOptions& global) {
+  const auto& advice = master.timeoutAdvice();
+  if (!advice) return;
+  const auto ms = [](SimTime ns) { return static_cast<double>(ns) / kNsPerMs; };
+  if (advice->raised) {
+    fmt::print(stderr,
+               "ecmaster: frame timeout raised from {:g} ms to {:.2f} ms: the count frame's round "
+               "trip through {} slaves was {:.3f} ms (set --timeout-ms to choose)\n",
+               ms(advice->before), ms(advice->needed), advice->slaves, ms(advice->roundTrip));
+  } else if (global.timeoutMs != 0 && advice->needed > advice->before) {
+    fmt::print(stderr,
+               "ecmaster: warning: --timeout-ms {} is short for this network: the count frame's "
+               "round trip through {} slaves was {:.3f} ms; frames may time out, set --timeout-ms "
+               "{} or more\n",
+               global.timeoutMs, advice->slaves, ms(advice->roundTrip),
+               (advice->needed + kNsPerMs - 1) / kNsPerMs);
+  }
+}
+
 Result<std::unique_ptr<Connection>> connectAndScan(const GlobalOptions& global, bool reset,
                                                    bool recovery) {
   master::MasterOptions options;
   options.scan.resetToDefaults = reset;
   options.recovery = recovery;
-  options.transport.timeout = static_cast<SimTime>(global.timeoutMs) * kNsPerMs;
+  if (global.timeoutMs != 0) {
+    options.transport.timeout = static_cast<SimTime>(global.timeoutMs) * kNsPerMs;
+    options.scan.adaptTimeout = false;  // the user's choice stands (a warning if too short)
+  }
   options.identity.serial = global.checkSerial;
   ECSIM_ASSIGN_OR_RETURN(auto connection, Connection::open(global.connect, options));
   if (!global.config.empty()) {
@@ -49,7 +73,9 @@ Result<std::unique_ptr<Connection>> connectAndScan(const GlobalOptions& global, 
   } else if (connection->simulated() && global.config.empty()) {
     connection->master().setSlaveNames(connection->simulatedNames());
   }
-  ECSIM_TRY(connection->master().scan());
+  const Status scanned = connection->master().scan();
+  reportTimeout(connection->master(), global);
+  ECSIM_TRY(scanned);
   const std::size_t named = connection->master().slaveNames().size();
   if (!global.names.empty() && named != connection->master().slaves().size()) {
     fmt::print(stderr, "ecmaster: warning: {} names {} slaves, the bus has {}\n", global.names,

@@ -33,7 +33,9 @@ int main(int argc, char** argv) {
   app.add_option("--names", global.names,
                  "Name the slaves by bus position after this topology or ENI file "
                  "(Drive1.Statusword); --sim TOPOLOGY names them by itself");
-  app.add_option("--timeout-ms", global.timeoutMs, "Frame timeout in ms (default 2)")
+  app.add_option("--timeout-ms", global.timeoutMs,
+                 "Frame timeout in ms (default: 2, raised to twice the round trip the scan "
+                 "measures on a long network; given: kept, with a warning when too short)")
       ->check(CLI::Range(1u, 10000u));
   app.add_flag("--json", global.json, "Machine-readable output");
   const std::vector<std::pair<std::string, CommandRunner>> commands{
