@@ -167,12 +167,21 @@ Status RawSocketLink::setReceiveTimeout(std::chrono::nanoseconds timeout) {
   return okStatus();
 }
 
+namespace {
+// Waits at least this long are one blocking recvmsg (SO_RCVTIMEO, counted in scheduler ticks);
+// shorter ones poll() with an exact timer (receive() below). `ecsim serve` idles 10 ms.
+constexpr std::chrono::nanoseconds kBlockingReceiveMin = std::chrono::milliseconds(10);
+}  // namespace
+
 Result<std::size_t> RawSocketLink::receive(Bytes buffer, std::chrono::nanoseconds timeout) {
-  // One blocking recvmsg, bounded by the socket's receive timeout (set again only when the
-  // timeout changes): one system call per frame, where trying first and then polling took
-  // three while the server idled between frames.
-  // Busy-polling: the same recvmsg without waiting, repeated until the deadline.
-  const bool wait = timeout > std::chrono::nanoseconds::zero() && !busyPoll_;
+  // A long wait (a server idling between frames) is one blocking recvmsg bounded by the
+  // socket's receive timeout (set again only when the timeout changes): one system call per
+  // frame, where trying first and then polling took three. SO_RCVTIMEO counts in scheduler
+  // ticks (4 ms at HZ=250), so a short wait (a master waiting for its frame, a server sharing
+  // its thread with a master) tries first and then waits in poll(), whose timer is exact.
+  // Busy-polling: recvmsg without waiting, repeated until the deadline.
+  const bool wait = timeout >= kBlockingReceiveMin && !busyPoll_;
+  const bool pollWait = !wait && !busyPoll_ && timeout > std::chrono::nanoseconds::zero();
   if (wait) ECSIM_TRY(setReceiveTimeout(timeout));
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   for (;;) {
@@ -193,8 +202,15 @@ Result<std::size_t> RawSocketLink::receive(Bytes buffer, std::chrono::nanosecond
       // loop looks at its SignalFlag (SO_RCVTIMEO waits are never restarted).
       if (errno == EINTR) return std::size_t{0};
       if (errno == EAGAIN || errno == EWOULDBLOCK) {
-        if (wait || !busyPoll_ || std::chrono::steady_clock::now() >= deadline) {
-          return std::size_t{0};
+        const auto left = deadline - std::chrono::steady_clock::now();
+        if (wait || left <= std::chrono::nanoseconds::zero()) return std::size_t{0};
+        if (pollWait) {
+          ECSIM_ASSIGN_OR_RETURN(
+              const bool readable,
+              waitReadable(fd_.get(), std::chrono::duration_cast<std::chrono::nanoseconds>(left)));
+          if (!readable) return std::size_t{0};
+        } else if (!busyPoll_) {
+          return std::size_t{0};  // no wait asked for
         }
         continue;
       }
