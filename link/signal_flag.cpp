@@ -22,7 +22,7 @@ SignalFlag::SignalFlag(std::initializer_list<int> signals) {
     struct sigaction action {};
     action.sa_handler = onStopSignal;
     sigemptyset(&action.sa_mask);
-    action.sa_flags = SA_RESETHAND;  // no SA_RESTART: blocking waits return early
+    action.sa_flags = static_cast<int>(SA_RESETHAND);  // no SA_RESTART: blocking waits return early
     Saved saved{sig, {}};
     if (::sigaction(sig, &action, &saved.previous) == 0) saved_.push_back(saved);
   }

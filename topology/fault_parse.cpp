@@ -134,7 +134,8 @@ Result<SimTime> durationArgument(const FaultAction& a, const FaultContext& conte
         "durationCycles needs our master's cycle time (an external master keeps its own): give "
         "durationMs");
   }
-  const auto most = std::max<std::uint64_t>(1, kMaxFaultDurationMs * kNsPerMs / context.cycleTime);
+  const auto most = std::max<std::uint64_t>(
+      1, kMaxFaultDurationMs * kNsPerMs / static_cast<std::uint64_t>(context.cycleTime));
   ECSIM_ASSIGN_OR_RETURN(auto n, a.number(kCyclesKey, 0, most));
   return saturatingMul(static_cast<SimTime>(n), context.cycleTime);
 }
@@ -295,7 +296,6 @@ Result<FaultAction> parseFaultAction(std::string_view line) {
   ECSIM_TRY(checkFaultArguments(action));
   return action;
 }
-
 
 // ---- Typed faults ---------------------------------------------------------------------------
 
@@ -487,9 +487,7 @@ struct Arguments {
   std::string operator()(const Latch& f) const {
     return fmt::format("slave={} unit={} level={}", argText(f.slave), f.unit, f.level ? 1 : 0);
   }
-  std::string operator()(const PauseMaster& f) const {
-    return "durationMs=" + ms(f.duration);
-  }
+  std::string operator()(const PauseMaster& f) const { return "durationMs=" + ms(f.duration); }
 };
 }  // namespace
 
