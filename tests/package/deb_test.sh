@@ -3,8 +3,9 @@
 # control fields checked (Depends names packages of this Debian system, installed size), then
 # unpacked into a scratch root (dpkg-deb -x: the system is not touched) and used with the source
 # and build trees hidden, in a private mount and network namespace: `ecsim --version`,
-# `ecsim demo`, `ecsim serve --veth` answering the package's own `ecmaster`, and the installed
-# examples/user-project built against the unpacked headers and CMake package.
+# `ecsim demo`, `ecsim replay` of the installed capture, `ecsim serve --veth` answering the
+# package's own `ecmaster`, and the installed examples/user-project built against the unpacked
+# headers and CMake package.
 # Needs root (namespaces); under CI=true a missing capability is a failure, otherwise a skip
 # (exit 77). Usage: deb_test.sh BUILD_DIR SOURCE_DIR VERSION
 set -eu
@@ -47,6 +48,10 @@ usr=$1 work=$2
 "$usr/bin/ecmaster" --version
 "$usr/bin/ecsim" demo --out "$work/demo" | tail -1
 [ -s "$work/demo/demo.pcap" ]
+# The installed capture against the installed demo topology (the replay's default).
+"$usr/bin/ecsim" replay --ignore-dc-time "$usr/share/ecsim/captures/soem-slaveinfo-demo.pcap" \
+  >"$work/replay.log" 2>&1 || { cat "$work/replay.log"; exit 1; }
+tail -2 "$work/replay.log"
 ip link set lo up
 "$usr/bin/ecsim" serve --veth debt >"$work/serve.log" 2>&1 &
 serve=$!
