@@ -14,6 +14,7 @@
 # topologies, and the real files of ECSIM_SHARED (default: ../shared next to the repository:
 # esi/, eeprom/, pcap/). Files longer than the target's max_len are left out for the XML
 # targets (a cut XML file only tests the parser's first error), cut by libFuzzer otherwise.
+# The targets run side by side, one per core (ECSIM_FUZZ_JOBS=N sets how many at a time).
 # The XML targets get a dictionary: tests/fuzz/xml.dict plus the element and attribute names
 # of their seeds.
 set -euo pipefail
@@ -41,6 +42,14 @@ for target in "${targets[@]}"; do
 done
 if [[ ! -d $shared ]]; then
   echo "run_fuzz: $shared not found: the real ESI, EEPROM and capture seeds are left out" >&2
+fi
+
+# The targets run side by side, ECSIM_FUZZ_JOBS at a time (default: one per core; each run is
+# one process on one core), and report in the order given.
+parallel=${ECSIM_FUZZ_JOBS:-$(nproc)}
+if ! [[ $parallel =~ ^[1-9][0-9]*$ ]]; then
+  echo "run_fuzz: ECSIM_FUZZ_JOBS must be a positive number, not '$parallel'" >&2
+  exit 2
 fi
 
 # ECSIM_FUZZ_NO_BUILD=1 runs what is built: for campaigns of several targets at once in one
@@ -90,12 +99,13 @@ seed_files() {
   esac 2>/dev/null || true
 }
 
-status=0
-for target in "${targets[@]}"; do
+# One target's run; its verdict goes to stdout/stderr, its exit status says whether it passed.
+fuzz_one() {
+  local target=$1
   binary=$build/tests/fuzz/$target
   if [[ ! -x $binary ]]; then
     echo "run_fuzz: $binary was not built (is the compiler clang and ECSIM_FUZZ ON?)" >&2
-    exit 1
+    return 1
   fi
   len=$(max_len "$target")
   corpus=$work/$target
@@ -134,11 +144,26 @@ for target in "${targets[@]}"; do
       [[ -e $artifact ]] || continue
       cp "$artifact" "$build/" && echo "run_fuzz: reproducer kept as $build/$(basename "$artifact")" >&2
     done
-    status=1
+    return 1
   else
     echo "run_fuzz: $target ok: $(grep -E '^stat::number_of_executed_units' "$log" | awk '{print $2}')" \
       "runs, $(grep -E '^stat::peak_rss_mb' "$log" | awk '{print $2}') MB peak, $(ls "$corpus" | wc -l)" \
       "corpus files, in $((SECONDS - start)) s"
   fi
+}
+
+# The targets run side by side (ECSIM_FUZZ_JOBS, above) and report in the order given.
+pids=()
+for target in "${targets[@]}"; do
+  while [[ $(jobs -rp | wc -l) -ge $parallel ]]; do wait -n || true; done
+  fuzz_one "$target" >"$work/$target.out" 2>&1 &
+  pids+=($!)
+done
+status=0
+for i in "${!targets[@]}"; do
+  rc=0
+  wait "${pids[$i]}" || rc=$?
+  cat "$work/${targets[$i]}.out"
+  [[ $rc -eq 0 ]] || status=1
 done
 exit $status
