@@ -188,7 +188,10 @@ Result<reg::RegisterInfo> lookUpRegister(std::string_view text) {
 }  // namespace
 
 std::string ControlApi::answer(std::string_view line, ClientId client, SimTime now) {
-  if (!line.empty() && line.front() == '{') return answerJson(line, client, now);
+  // JSON starts with '{' (a '[' too, refused as not an object); no fault action does.
+  if (!line.empty() && (line.front() == '{' || line.front() == '[')) {
+    return answerJson(line, client, now);
+  }
   return answerFault(line, now);
 }
 
