@@ -68,6 +68,14 @@ TEST(CtlOutputs, EcsimCtlGetReadsWhatSoemWroteToDO1) {
       << readText(serveLog);
   // Before the master: DO1 is in INIT and its outputs are off.
   EXPECT_EQ(ctl(socket, {"get", "DO1", "Output 8"}).out, "0\n");
+  // A subscriber from before the master: told the value now and once when the master sets it.
+  const std::string subscribeLog = ::testing::TempDir() + "ctl_subscribe_" + tag + ".log";
+  auto subscriber = spawnProcess(
+      {kEcsim, "ctl", "--socket", socket, "subscribe", "DO1", "Output 8", "--count", "1"},
+      SpawnOptions{subscribeLog, subscribeLog});
+  ASSERT_TRUE(subscriber.ok()) << subscriber.error().message();
+  ASSERT_TRUE(waitFor(subscribeLog, "DO1.Output 8 0", *subscriber, std::chrono::seconds(10)))
+      << readText(subscribeLog);
 
   // DO1 is SOEM's slave 3 (Coupler 1, DI1 2); 30 s of cycles bound the test, it stops the
   // master when done.
@@ -90,6 +98,11 @@ TEST(CtlOutputs, EcsimCtlGetReadsWhatSoemWroteToDO1) {
     EXPECT_EQ(r.out, std::string(1, expected[static_cast<std::size_t>(8 - n)]) + "\n")
         << "Output " << n;
   }
+  auto subscribed = subscriber->wait(std::chrono::seconds(10));
+  ASSERT_TRUE(subscribed.ok());
+  EXPECT_EQ(*subscribed, 0);
+  EXPECT_EQ(readText(subscribeLog), "DO1.Output 8 0\nDO1.Output 8 1\n");
+  std::filesystem::remove(subscribeLog);
   // The slave is in OP as the master left it, and the state query says so.
   const CtlResult state = ctl(socket, {"state"});
   EXPECT_EQ(state.status, 0);

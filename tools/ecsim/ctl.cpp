@@ -37,7 +37,7 @@ constexpr std::string_view kQueryHelp =
     "  state                      every slave's AL state and status code\n"
     "  faults                     the fault actions applied through the socket\n"
     "  subscribe SLAVE ENTRY      print the entry's value at every change (--count N)\n"
-    "  '{\"op\":...}'              a JSON request, its answer printed as is\n";
+    "  '{\"op\":...}'               a JSON request, its answer printed as is\n";
 
 bool isObjectIndex(const std::string& s) {
   return s.size() > 2 && s[0] == '0' && (s[1] == 'x' || s[1] == 'X') &&
@@ -205,6 +205,13 @@ int runCtl(const CtlOptions& o) {
     fmt::print(stderr, "ecsim ctl: give --socket or --iface, not both\n");
     return 2;
   }
+  // Usage first: a wrong command line needs no server.
+  const bool raw = o.words.size() == 1 && !o.words[0].empty() && o.words[0][0] == '{';
+  auto request = raw ? Result<nlohmann::json>(nlohmann::json(nullptr)) : queryRequest(o.words);
+  if (!request.ok()) {
+    fmt::print(stderr, "ecsim ctl: {}\n", request.error().message());
+    return 2;
+  }
   std::filesystem::path socket = o.socket;
   if (!o.iface.empty()) socket = topology::defaultControlSocket(o.iface);
   if (socket.empty()) {
@@ -214,12 +221,6 @@ int runCtl(const CtlOptions& o) {
       return 2;
     }
     socket = *found;
-  }
-  const bool raw = o.words.size() == 1 && !o.words[0].empty() && o.words[0][0] == '{';
-  auto request = raw ? Result<nlohmann::json>(nlohmann::json(nullptr)) : queryRequest(o.words);
-  if (!request.ok()) {
-    fmt::print(stderr, "ecsim ctl: {}\n", request.error().message());
-    return 2;
   }
   if (raw || !request->is_null()) return runQuery(socket, o, *request, raw);
   std::string line;
