@@ -95,6 +95,33 @@ ControlServer::~ControlServer() {
 }
 
 void ControlServer::poll(const Handler& handler, SimTime now) {
+  poll(ClientHandler([&handler](std::string_view line, ClientId) { return handler(line); }), now);
+}
+
+bool ControlServer::connected(ClientId client) const {
+  return std::any_of(clients_.begin(), clients_.end(),
+                     [client](const Client& c) { return c.id == client && !c.closing; });
+}
+
+void ControlServer::holdOpen(ClientId client) {
+  for (auto& c : clients_) {
+    if (c.id == client) c.held = true;
+  }
+}
+
+bool ControlServer::push(ClientId client, std::string_view line) {
+  for (auto& c : clients_) {
+    if (c.id != client || c.closing) continue;
+    if (c.reply.size() >= kControlMaxPendingReply) return false;
+    c.reply.append(line);
+    c.reply += '\n';
+    if (!sendSome(c.fd.get(), c.reply)) c.closing = true;
+    return true;
+  }
+  return false;
+}
+
+void ControlServer::poll(const ClientHandler& handler, SimTime now) {
   accept(now);
   for (auto it = clients_.begin(); it != clients_.end();) {
     if (serve(*it, handler, now)) {
@@ -118,11 +145,12 @@ void ControlServer::accept(SimTime now) {
     Client c;
     c.fd = std::move(client);
     c.lastHeard = now;
+    c.id = ++lastId_;
     clients_.push_back(std::move(c));
   }
 }
 
-bool ControlServer::serve(Client& c, const Handler& handler, SimTime now) {
+bool ControlServer::serve(Client& c, const ClientHandler& handler, SimTime now) {
   if (!sendSome(c.fd.get(), c.reply)) return false;
   std::size_t budget = kReadPerPoll;
   char buf[4096];
@@ -140,7 +168,7 @@ bool ControlServer::serve(Client& c, const Handler& handler, SimTime now) {
     c.closing = true;  // closed by the client (its lines are answered), or broken
   }
   if (c.closing && c.reply.empty()) return false;
-  if (now - c.lastHeard > limits_.idleTimeout) {
+  if (!c.held && now - c.lastHeard > limits_.idleTimeout) {
     std::string bye = "error nothing received for " +
                       std::to_string(limits_.idleTimeout / kNsPerSecond) + " s: closed\n";
     (void)sendSome(c.fd.get(), bye);
@@ -149,7 +177,8 @@ bool ControlServer::serve(Client& c, const Handler& handler, SimTime now) {
   return true;
 }
 
-void ControlServer::takeLines(Client& c, std::string_view data, const Handler& handler) {
+void ControlServer::takeLines(Client& c, std::string_view data,
+                              const ClientHandler& handler) {
   while (!data.empty()) {
     const std::size_t nl = data.find('\n');
     const std::string_view piece = data.substr(0, nl);
@@ -166,7 +195,7 @@ void ControlServer::takeLines(Client& c, std::string_view data, const Handler& h
     }
     c.buffer.append(piece);
     if (nl == std::string_view::npos) return;
-    c.reply += handler(c.buffer) + "\n";
+    c.reply += handler(c.buffer, c.id) + "\n";
     c.buffer.clear();
   }
 }
@@ -206,8 +235,8 @@ Result<std::filesystem::path> findControlSocket(const std::filesystem::path& dir
                        "): choose one with --iface IF or --socket PATH");
 }
 
-Result<std::string> sendControlLine(const std::filesystem::path& path, std::string_view line,
-                                    std::chrono::milliseconds timeout) {
+Result<ControlConnection> ControlConnection::open(const std::filesystem::path& path,
+                                                  std::chrono::milliseconds timeout) {
   auto addr = socketAddress(path);
   if (!addr.ok()) return addr.takeError();
   UniqueFd fd(::socket(AF_UNIX, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0));
@@ -228,28 +257,51 @@ Result<std::string> sendControlLine(const std::filesystem::path& path, std::stri
     }
     ::poll(nullptr, 0, kConnectRetryMs);
   }
+  return ControlConnection(std::move(fd), path);
+}
+
+Status ControlConnection::sendLine(std::string_view line, std::chrono::milliseconds timeout) {
   std::string request = std::string(line) + "\n";
   while (!request.empty()) {
-    if (!waitWritable(fd.get(), timeout)) {
-      return makeError(ErrorCode::kTimeout, path.string() + ": the server takes no request");
+    if (!waitWritable(fd_.get(), timeout)) {
+      return makeError(ErrorCode::kTimeout, path_.string() + ": the server takes no request");
     }
-    if (!sendSome(fd.get(), request)) {
-      return makeError(ErrorCode::kIo, path.string() + ": send: " + errnoText(errno));
+    if (!sendSome(fd_.get(), request)) {
+      return makeError(ErrorCode::kIo, path_.string() + ": send: " + errnoText(errno));
     }
   }
-  std::string reply;
-  while (reply.find('\n') == std::string::npos) {
-    auto readable = waitReadable(fd.get(), timeout);
+  return okStatus();
+}
+
+Result<std::string> ControlConnection::readLine(std::chrono::milliseconds timeout) {
+  while (buffer_.find('\n') == std::string::npos) {
+    auto readable = waitReadable(fd_.get(), timeout);
     if (!readable.ok()) return readable.takeError();
-    if (!*readable) return makeError(ErrorCode::kTimeout, path.string() + ": no reply");
+    if (!*readable) return makeError(ErrorCode::kTimeout, path_.string() + ": no reply");
     char buf[512];
-    const ssize_t n = ::recv(fd.get(), buf, sizeof(buf), 0);
+    const ssize_t n = ::recv(fd_.get(), buf, sizeof(buf), 0);
     if (n < 0 && (errno == EAGAIN || errno == EINTR)) continue;
-    if (n <= 0) break;
-    reply.append(buf, static_cast<std::size_t>(n));
+    if (n <= 0) {
+      if (buffer_.empty()) {
+        return makeError(ErrorCode::kIo, path_.string() + ": the server closed the connection");
+      }
+      buffer_ += '\n';  // the last line, unterminated
+      break;
+    }
+    buffer_.append(buf, static_cast<std::size_t>(n));
   }
-  if (auto nl = reply.find('\n'); nl != std::string::npos) reply.resize(nl);
-  return reply;
+  const auto nl = buffer_.find('\n');
+  std::string line = buffer_.substr(0, nl);
+  buffer_.erase(0, nl + 1);
+  return line;
+}
+
+Result<std::string> sendControlLine(const std::filesystem::path& path, std::string_view line,
+                                    std::chrono::milliseconds timeout) {
+  auto connection = ControlConnection::open(path, timeout);
+  if (!connection.ok()) return connection.takeError();
+  if (auto sent = connection->sendLine(line, timeout); !sent.ok()) return sent.takeError();
+  return connection->readLine(timeout);
 }
 
 }  // namespace ecsim::topology

@@ -9,11 +9,13 @@
 // longer than kControlMaxLine bytes is answered "error line longer than N bytes" and discarded
 // up to its newline, the connection goes on. Every complete line is answered, in order; while
 // a client does not read its answers (more than kControlMaxPendingReply bytes waiting), its
-// further lines wait in the socket.
+// further lines wait in the socket. Lines pushed to a client (push(): a subscription's
+// changes) count in the same pending reply: over the limit, push() refuses them.
 #pragma once
 
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -40,6 +42,9 @@ class ControlServer {
  public:
   // Handles one request line; returns the reply (without newline).
   using Handler = std::function<std::string(std::string_view line)>;
+  // Clients are numbered from 1 in the order they connect; a number is never reused.
+  using ClientId = std::uint64_t;
+  using ClientHandler = std::function<std::string(std::string_view line, ClientId client)>;
 
   // Creates the socket at `path` (a stale socket file there is replaced; the directory is
   // created with mode 0700 when missing).
@@ -51,6 +56,14 @@ class ControlServer {
   // Accepts waiting clients, reads complete lines, answers them, closes clients idle since
   // before `now - idleTimeout` (`now` from the caller's clock). Never blocks.
   void poll(const Handler& handler, SimTime now);
+  void poll(const ClientHandler& handler, SimTime now);
+  // Queues `line` (a newline is added) for the client and sends what its socket takes now;
+  // false when the client is gone or has more than kControlMaxPendingReply bytes unread.
+  bool push(ClientId client, std::string_view line);
+  bool connected(ClientId client) const;
+  // The idle timeout no longer closes the client (it waits for pushed lines, e.g. a
+  // subscription); it is closed when it closes its side.
+  void holdOpen(ClientId client);
   const std::filesystem::path& path() const { return path_; }
   std::size_t clients() const { return clients_.size(); }
 
@@ -64,16 +77,38 @@ class ControlServer {
     bool discarding{false};  // inside a line over the limit: dropped up to its newline
     bool closing{false};     // the client closed its side, or must be closed
     SimTime lastHeard{0};
+    ClientId id{0};
+    bool held{false};  // holdOpen: exempt from the idle timeout
   };
   void accept(SimTime now);
   // Reads what the client sent and answers its complete lines; false when it is to be closed.
-  bool serve(Client& client, const Handler& handler, SimTime now);
-  void takeLines(Client& client, std::string_view data, const Handler& handler);
+  bool serve(Client& client, const ClientHandler& handler, SimTime now);
+  void takeLines(Client& client, std::string_view data, const ClientHandler& handler);
 
   UniqueFd fd_;
   std::filesystem::path path_;
   ControlLimits limits_;
   std::vector<Client> clients_;
+  ClientId lastId_{0};
+};
+
+// The client end of one connection (`ecsim ctl`): lines out, lines in.
+class ControlConnection {
+ public:
+  // Connects, giving up after `timeout` when the server does not accept.
+  static Result<ControlConnection> open(const std::filesystem::path& path,
+                                        std::chrono::milliseconds timeout);
+  Status sendLine(std::string_view line, std::chrono::milliseconds timeout);
+  // The next line (without its newline); kTimeout when none within `timeout`, kIo when the
+  // server closed the connection.
+  Result<std::string> readLine(std::chrono::milliseconds timeout);
+
+ private:
+  ControlConnection(UniqueFd fd, std::filesystem::path path)
+      : fd_(std::move(fd)), path_(std::move(path)) {}
+  UniqueFd fd_;
+  std::filesystem::path path_;
+  std::string buffer_;
 };
 
 class FaultInjector;

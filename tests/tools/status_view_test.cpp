@@ -29,7 +29,7 @@ StatusSnapshot sample() {
   a.frames = 1230;
   a.datagrams = 2460;
   a.dcDifferenceNs = -17;
-  a.values.push_back({0x6000, 1, false, 1});
+  a.values.push_back({"DI\"1.Input 1", 0x6000, 1, false, 1});
   SlaveStatus b;
   b.name = "Drive1";
   b.state = AlState::kSafeOp;
@@ -37,7 +37,7 @@ StatusSnapshot sample() {
   b.alStatusCode = 0x001B;
   b.rxErrors = 3;
   b.lostLinks = 1;
-  b.values.push_back({0x6040, 0, true, 15});
+  b.values.push_back({"Drive1.Controlword", 0x6040, 0, true, 15});
   snap.slaves = {a, b};
   return snap;
 }
@@ -80,7 +80,10 @@ TEST(StatusView, JsonCarriesTheSameContentAndEscapesNames) {
   EXPECT_NE(json.find("\"alStatusCode\":27,"), std::string::npos);
   EXPECT_NE(json.find("\"alError\":true"), std::string::npos);
   EXPECT_NE(json.find("\"dcDifferenceNs\":-17"), std::string::npos);
-  EXPECT_NE(json.find("{\"entry\":\"6040:00\",\"output\":true,\"value\":15}"), std::string::npos);
+  EXPECT_NE(json.find("{\"name\":\"Drive1.Controlword\",\"entry\":\"6040:00\",\"output\":true,"
+                      "\"value\":15}"),
+            std::string::npos)
+      << json;
   // Balanced braces and brackets (a cheap well-formedness check).
   int braces = 0;
   int brackets = 0;
@@ -118,9 +121,23 @@ TEST(StatusView, SnapshotOfTheDemoNetwork) {
   EXPECT_EQ(snap.slaves[1].values[0].value, 1);
   EXPECT_EQ(snap.slaves[1].values[1].value, 0);
   EXPECT_EQ(snap.slaves[1].values[2].value, 1);
-  // DO1's are outputs.
-  ASSERT_FALSE(snap.slaves[2].values.empty());
+  // DO1's are outputs, every one of the 8 listed (not only the table's first 4), named as a
+  // master names them (ecsim_devices.xml, ECS2008's RxPDO entries "Output 1".."Output 8").
+  ASSERT_EQ(snap.slaves[2].values.size(), 8u);
   EXPECT_TRUE(snap.slaves[2].values[0].output);
+  EXPECT_EQ(snap.slaves[2].values[0].name, "DO1.Output 1");
+  EXPECT_EQ(snap.slaves[2].values[7].name, "DO1.Output 8");
+  EXPECT_EQ(snap.slaves[1].values[0].name, "DI1.Input 1");
+  // Drive1's Statusword, from its TxPDO, among its entries.
+  bool statusword = false;
+  for (const auto& v : snap.slaves[4].values) statusword |= v.name == "Drive1.Statusword";
+  EXPECT_TRUE(statusword);
+  const std::string json = formatStatusJson(snap);
+  EXPECT_NE(json.find("\"name\":\"DO1.Output 8\""), std::string::npos) << json;
+  // The table keeps its first kTableValues entries per slave.
+  const std::string table = formatStatusTable(snap);
+  EXPECT_NE(table.find(">7000:04="), std::string::npos) << table;
+  EXPECT_EQ(table.find(">7000:05="), std::string::npos) << table;
 }
 
 TEST(StatusView, WritesJsonAtomicallyAndReportsPeriodically) {

@@ -21,6 +21,7 @@
 #include "link/veth_setup.hpp"
 #include "slavesim/generic_slave.hpp"
 #include "tools/ecsim/commands.hpp"
+#include "tools/ecsim/control_api.hpp"
 #include "tools/ecsim/status_view.hpp"
 #include "topology/control_server.hpp"
 #include "topology/faults.hpp"
@@ -226,10 +227,9 @@ int runServe(ServeOptions o) {
     std::fflush(stdout);
   }
   StatusReporter reporter(o.status, o.statusJson);
-  // Live injection (docs/scenarios.md): fault actions as text lines on a Unix socket. The
-  // injector is made at the first action: as the segment's wire faults it turns off the
-  // replay of the recorded route (docs/timing.md), which a network without faults keeps.
-  std::optional<topology::FaultInjector> faults;
+  // The control socket (docs/control.md): queries, process data, subscriptions and fault
+  // actions (docs/scenarios.md, "Live injection").
+  ControlApi api(network);
   if (o.control.empty()) {
     o.control = topology::defaultControlSocket(o.iface.empty() ? o.tap : o.iface).string();
   }
@@ -241,9 +241,8 @@ int runServe(ServeOptions o) {
                o.control);
     std::fflush(stdout);
   }
-  auto handle = [&](std::string_view line) -> std::string {
-    if (!faults) faults.emplace(network, 1);
-    return topology::answerFaultLine(*faults, line, clock.now());
+  auto handle = [&](std::string_view line, topology::ControlServer::ClientId client) {
+    return api.answer(line, client, clock.now());
   };
   // Captures reach the disk when the server idles and at least every kCaptureFlushInterval
   // under traffic; a capture error is reported at once and fails the run (it serves on).
@@ -266,7 +265,10 @@ int runServe(ServeOptions o) {
     const SimTime now = clock.now();
     if (!idle && now < housekeepingDue) return stop.raised();
     housekeepingDue = now + kHousekeepingInterval;
-    if (control.ok()) control->poll(handle, now);
+    if (control.ok()) {
+      control->poll(topology::ControlServer::ClientHandler(handle), now);
+      api.publish(*control);
+    }
     reporter.tick(now, segment, server.counters());
     for (std::size_t i = 0; i < writers.size(); ++i) {
       reportCapture(taps[i]->status());
@@ -311,7 +313,7 @@ CommandRunner addServeCommand(CLI::App& app) {
   cmd->add_option("--pcap-malformed", opts->pcapMalformed,
                   "Capture the malformed frames the simulator dropped to this pcap file");
   cmd->add_option("--control", opts->control,
-                  "Control socket for live fault injection (default /run/ecsim/IFACE.sock)");
+                  "Control socket for queries and live fault injection (default /run/ecsim/IFACE.sock)");
   cmd->add_flag("--paced", opts->paced, "Answer at the modelled round-trip time");
   cmd->add_flag("--quiet", opts->quiet, "Print only the final statistics");
   cmd->add_flag("--rt", opts->realtime, "Run with SCHED_FIFO priority and locked memory");

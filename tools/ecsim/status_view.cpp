@@ -9,6 +9,8 @@
 #include "protocol/registers.hpp"
 #include "slavesim/coe/data_types.hpp"
 #include "slavesim/esi_slave.hpp"
+#include "tools/ecsim/slave_variables.hpp"
+#include "topology/slave_names.hpp"
 
 namespace ecsim::tools {
 namespace {
@@ -50,7 +52,8 @@ std::string stateText(const SlaveStatus& s) {
 
 std::string valuesText(const SlaveStatus& s) {
   std::string out;
-  for (const auto& v : s.values) {
+  for (std::size_t i = 0; i < s.values.size() && i < kTableValues; ++i) {
+    const auto& v = s.values[i];
     if (!out.empty()) out += ' ';
     out += fmt::format("{}{:04X}:{:02X}={}", v.output ? '>' : '<', v.index, v.subindex, v.value);
   }
@@ -80,6 +83,9 @@ StatusSnapshot takeStatusSnapshot(topology::Segment& segment,
   snap.sendErrors = counters.sendErrors;
   snap.framesPerSecond = framesPerSecond;
   snap.lastRoundTrip = counters.lastRoundTrip;
+  // Named as the control socket and a master name them, in bus order.
+  const std::vector<master::VariableInfo> variables = slaveVariables(segment);
+  const std::vector<std::size_t> order = topology::busOrder(segment);
   for (std::size_t i = 0; i < segment.size(); ++i) {
     slavesim::Slave& slave = segment.slave(i);
     const slavesim::Esc& esc = slave.esc();
@@ -99,23 +105,20 @@ StatusSnapshot takeStatusSnapshot(topology::Segment& segment,
     s.dcDifferenceNs = decodeSystemTimeDifference(esc.read(reg::kSystemTimeDifference));
     if (auto* device = slavesim::processDataDeviceOf(slave)) {
       const auto& od = device->dictionary();
-      for (const auto& sm : device->binding().layout()) {
-        for (const auto& entry : sm.entries) {
-          if (s.values.size() >= maxValues) break;
-          if (entry.index == 0) continue;  // a gap
-          const auto* e = od.findEntry(entry.index, entry.subindex);
-          if (e == nullptr) continue;
-          std::int64_t value = 0;
-          if (slavesim::coe::isRealType(e->dataType)) {
-            value = static_cast<std::int64_t>(od.getOr<double>(entry.index, entry.subindex, 0.0));
-          } else if (slavesim::coe::isSignedType(e->dataType)) {
-            value = od.getOr<std::int64_t>(entry.index, entry.subindex, 0);
-          } else {  // BOOL, BITn, UNSIGNEDn: never sign-extended
-            value =
-                static_cast<std::int64_t>(od.getOr<std::uint64_t>(entry.index, entry.subindex, 0));
-          }
-          s.values.push_back({entry.index, entry.subindex, sm.outputs, value});
+      for (const auto& v : variables) {
+        if (v.position >= order.size() || order[v.position] != i) continue;
+        if (s.values.size() >= maxValues) break;
+        const auto* e = od.findEntry(v.index, v.subindex);
+        if (e == nullptr) continue;
+        std::int64_t value = 0;
+        if (slavesim::coe::isRealType(e->dataType)) {
+          value = static_cast<std::int64_t>(od.getOr<double>(v.index, v.subindex, 0.0));
+        } else if (slavesim::coe::isSignedType(e->dataType)) {
+          value = od.getOr<std::int64_t>(v.index, v.subindex, 0);
+        } else {  // BOOL, BITn, UNSIGNEDn: never sign-extended
+          value = static_cast<std::int64_t>(od.getOr<std::uint64_t>(v.index, v.subindex, 0));
         }
+        s.values.push_back({v.name, v.index, v.subindex, v.output, value});
       }
     }
     snap.slaves.push_back(std::move(s));
@@ -162,8 +165,9 @@ std::string formatStatusJson(const StatusSnapshot& snap) {
     for (std::size_t v = 0; v < s.values.size(); ++v) {
       const ProcessValue& pv = s.values[v];
       if (v > 0) out += ',';
-      out += fmt::format("{{\"entry\":\"{:04X}:{:02X}\",\"output\":{},\"value\":{}}}", pv.index,
-                         pv.subindex, pv.output ? "true" : "false", pv.value);
+      out += fmt::format("{{\"name\":{},\"entry\":\"{:04X}:{:02X}\",\"output\":{},\"value\":{}}}",
+                         jsonString(pv.name), pv.index, pv.subindex, pv.output ? "true" : "false",
+                         pv.value);
     }
     out += "]}";
   }

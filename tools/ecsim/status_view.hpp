@@ -19,6 +19,7 @@
 namespace ecsim::tools {
 
 struct ProcessValue {
+  std::string name;  // "DO1.Output 8" (slave_variables.hpp)
   std::uint16_t index{0};
   std::uint8_t subindex{0};
   bool output{false};  // RxPDO (from the master) or TxPDO (to the master)
@@ -36,7 +37,7 @@ struct SlaveStatus {
   std::uint32_t lostLinks{0};  // lost link counters, all ports
   // System time difference (0x092C), sign-magnitude decoded: local copy minus received.
   std::int64_t dcDifferenceNs{0};
-  std::vector<ProcessValue> values;  // the first few mapped process-data entries
+  std::vector<ProcessValue> values;  // the mapped process-data entries (up to maxValues)
 };
 
 struct StatusSnapshot {
@@ -54,13 +55,18 @@ struct StatusSnapshot {
 // Decodes 0x092C: bit 31 set means the local copy is smaller than the received time.
 std::int64_t decodeSystemTimeDifference(std::uint32_t raw);
 
+// How many process-data entries per slave the terminal table shows.
+inline constexpr std::size_t kTableValues = 4;
+
 // Reads the server counters and every slave's registers and process data. maxValues limits
-// the process-data entries listed per slave.
+// the process-data entries listed per slave (the JSON status lists them all).
 StatusSnapshot takeStatusSnapshot(topology::Segment& segment,
                                   const topology::ServerCounters& counters, SimTime uptime,
-                                  double framesPerSecond, std::size_t maxValues = 4);
+                                  double framesPerSecond,
+                                  std::size_t maxValues = static_cast<std::size_t>(-1));
 
-// A plain table (no terminal control codes), one line per slave, ending in a newline.
+// A plain table (no terminal control codes), one line per slave with its first kTableValues
+// process-data entries, ending in a newline.
 std::string formatStatusTable(const StatusSnapshot& snapshot);
 // The same content as one JSON object.
 std::string formatStatusJson(const StatusSnapshot& snapshot);
