@@ -7,7 +7,12 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <pthread.h>
+#include <sched.h>
+
 #include <atomic>
+#include <cstdio>
+#include <cstring>
 #include <memory>
 #include <optional>
 #include <string>
@@ -164,7 +169,9 @@ class Slave {
 // Serving on an interface: a thread runs SimulatedNetwork::serve until close().
 class Serving {
  public:
-  Serving(std::shared_ptr<Network> net, std::unique_ptr<RawSocketLink> link);
+  // rtPriority > 0: the thread runs SCHED_FIFO at it (as `ecsim serve --rt`), so that answers
+  // come within a master's timeout on a loaded host; refused, a note on stderr.
+  Serving(std::shared_ptr<Network> net, std::unique_ptr<RawSocketLink> link, int rtPriority);
   ~Serving() {
     if (thread_.joinable()) (void)join();
   }
@@ -227,7 +234,8 @@ class Network : public std::enable_shared_from_this<Network> {
     return *done;
   }
 
-  std::unique_ptr<Serving> serve(const std::string& iface, const std::string& netns) {
+  std::unique_ptr<Serving> serve(const std::string& iface, const std::string& netns,
+                                 int rtPriority) {
     if (net_->options().time != embed::TimeMode::kRealTime) {
       throw std::runtime_error("serve: the network runs on virtual time; make it with "
                                "ecsim.Network(path, real_time=True)");
@@ -236,7 +244,7 @@ class Network : public std::enable_shared_from_this<Network> {
     RawSocketOptions options;
     options.netns = netns;
     auto link = std::make_unique<RawSocketLink>(take(RawSocketLink::open(iface, options)));
-    return std::make_unique<Serving>(shared_from_this(), std::move(link));
+    return std::make_unique<Serving>(shared_from_this(), std::move(link), rtPriority);
   }
 
   void requireIdle(const char* what) const {
@@ -250,11 +258,22 @@ class Network : public std::enable_shared_from_this<Network> {
   bool serving_{false};
 };
 
-Serving::Serving(std::shared_ptr<Network> net, std::unique_ptr<RawSocketLink> link)
+Serving::Serving(std::shared_ptr<Network> net, std::unique_ptr<RawSocketLink> link,
+                 int rtPriority)
     : net_(std::move(net)), link_(std::move(link)) {
   net_->sim().attach(*link_);
   net_->setServing(true);
-  thread_ = std::thread([this] { status_ = net_->sim().serve([this] { return stop_.load(); }); });
+  thread_ = std::thread([this, rtPriority] {
+    if (rtPriority > 0) {
+      sched_param param{};
+      param.sched_priority = rtPriority;
+      if (const int rc = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param); rc != 0) {
+        std::fprintf(stderr, "ecsim: serve: SCHED_FIFO %d not permitted (%s)\n", rtPriority,
+                     std::strerror(rc));
+      }
+    }
+    status_ = net_->sim().serve([this] { return stop_.load(); });
+  });
 }
 Status Serving::join() {
   if (!thread_.joinable()) return okStatus();
@@ -492,7 +511,8 @@ PYBIND11_MODULE(_ecsim, m) {
                     for (auto v : ecsim::topology::faultVerbs()) out.emplace_back(v);
                     return out;
                   })
-      .def("serve", &Network::serve, py::arg("iface"), py::arg("netns") = "");
+      .def("serve", &Network::serve, py::arg("iface"), py::arg("netns") = "",
+           py::arg("rt_priority") = 0);
 
   py::class_<Master>(m, "Master")
       .def(py::init([](std::shared_ptr<Network> net, double cycleMs,

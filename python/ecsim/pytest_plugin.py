@@ -34,5 +34,4 @@ def ecsim_network(ecsim_topology):
 def ecsim_master(ecsim_network):
     master = ecsim.Master(ecsim_network)
     master.start()
-    yield master
-    master.stop()
+    return master
