@@ -11,6 +11,7 @@
 #include <sched.h>
 
 #include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -199,7 +200,19 @@ class Network : public std::enable_shared_from_this<Network> {
   }
 
   embed::SimulatedNetwork& sim() { return *net_; }
-  std::unique_lock<std::mutex> lock() { return net_->lock(); }
+  // The network's lock for an access from Python. SimulatedNetwork::serve takes the lock again
+  // right after each step, and a std::mutex is not fair: a thread that only waits for it can
+  // wait for seconds. So a waiter says so, and the serving thread lets it in between steps.
+  std::unique_lock<std::mutex> lock() {
+    ++waiting_;
+    auto guard = net_->lock();
+    --waiting_;
+    return guard;
+  }
+  // The serving thread, between two steps: sleeps while an access waits for the lock.
+  void letWaitersIn() const {
+    while (waiting_.load() > 0) std::this_thread::sleep_for(std::chrono::microseconds(20));
+  }
   bool serving() const { return serving_; }
   void setServing(bool on) { serving_ = on; }
 
@@ -256,6 +269,7 @@ class Network : public std::enable_shared_from_this<Network> {
   std::unique_ptr<topology::FaultInjector> faults_;
   std::uint64_t seed_{1};
   bool serving_{false};
+  std::atomic<int> waiting_{0};
 };
 
 Serving::Serving(std::shared_ptr<Network> net, std::unique_ptr<RawSocketLink> link,
@@ -272,7 +286,10 @@ Serving::Serving(std::shared_ptr<Network> net, std::unique_ptr<RawSocketLink> li
                      std::strerror(rc));
       }
     }
-    status_ = net_->sim().serve([this] { return stop_.load(); });
+    status_ = net_->sim().serve([this] {
+      net_->letWaitersIn();
+      return stop_.load();
+    });
   });
 }
 Status Serving::join() {
