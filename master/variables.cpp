@@ -13,6 +13,13 @@ namespace {
 // How many of the nearest names an unknown variable's error lists.
 constexpr std::size_t kClosestListed = 4;
 
+std::string hexIndex(std::uint16_t index, std::uint8_t subindex) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "0x%04X:%02X", static_cast<unsigned>(index),
+                static_cast<unsigned>(subindex));
+  return buf;
+}
+
 // The SII's order string ("ECS1008", "EL2004"): short, without spaces; else the device name.
 std::string siiName(const SlaveInfo& slave) {
   const auto& general = slave.siiContents.general;
@@ -188,13 +195,6 @@ std::string PdoVariable::format() const {
   }
   if (isSigned(info_.type)) return std::to_string(signedValue());
   return std::to_string(raw());
-}
-
-std::string hexIndex(std::uint16_t index, std::uint8_t subindex) {
-  char buf[16];
-  std::snprintf(buf, sizeof buf, "0x%04X:%02X", static_cast<unsigned>(index),
-                static_cast<unsigned>(subindex));
-  return buf;
 }
 
 std::vector<VariableInfo> nameVariables(const ProcessImageLayout& layout,

@@ -107,9 +107,6 @@ class PdoVariable {
   std::vector<std::uint8_t>* image_;
 };
 
-// "0x6041:00": an entry's index and subindex as variable names spell them.
-std::string hexIndex(std::uint16_t index, std::uint8_t subindex);
-
 // Every entry of the layout, named as above.
 std::vector<VariableInfo> nameVariables(const ProcessImageLayout& layout,
                                         const std::vector<SlaveInfo>& slaves);

@@ -62,6 +62,14 @@ T take(Result<T> result) {
   return std::move(*result);
 }
 
+// "0x7000:03", as master/variables.cpp spells an entry's index in variable names.
+std::string hexIndex(std::uint16_t index, std::uint8_t subindex) {
+  char text[16];
+  std::snprintf(text, sizeof text, "0x%04X:%02X", static_cast<unsigned>(index),
+                static_cast<unsigned>(subindex));
+  return text;
+}
+
 // ---- values: the bits of an entry, typed as the master types its variables ------------------
 master::VariableInfo valueInfo(std::uint16_t dataType, std::uint16_t bitLength) {
   master::VariableInfo info;
@@ -326,7 +334,7 @@ const slavesim::coe::Entry& Slave::entry(std::uint16_t index, std::uint8_t subin
   if (od == nullptr) throw std::runtime_error("slave '" + name() + "' has no object dictionary");
   const auto* e = od->findEntry(index, subindex);
   if (e == nullptr) {
-    throw py::key_error("slave '" + name() + "' has no object " + master::hexIndex(index, subindex));
+    throw py::key_error("slave '" + name() + "' has no object " + hexIndex(index, subindex));
   }
   return *e;
 }
@@ -362,7 +370,7 @@ std::vector<Slave::Named> Slave::processEntries() {
 Slave::Named Slave::find(const std::string& name) {
   auto entries = processEntries();
   for (const auto& n : entries) {
-    if (n.name == name || master::hexIndex(n.index, n.subindex) == name) return n;
+    if (n.name == name || hexIndex(n.index, n.subindex) == name) return n;
   }
   std::vector<std::string_view> names;
   for (const auto& n : entries) names.push_back(n.name);
