@@ -69,7 +69,7 @@ echo "user project against the package: ok"
 # The Python module from the package, its pytest fixtures on the installed demo network.
 printf '%s\n' 'def test_installed(ecsim_network, ecsim_master):' \
   '    assert ecsim_network.slave("DO1").state == "OP"' >"$work/test_installed.py"
-PYTHONPATH="$usr/lib/python3/dist-packages" PYTHONDONTWRITEBYTECODE=1 /usr/bin/python3 -m pytest \
+cd "$work" && PYTHONPATH="$usr/lib/python3/dist-packages" PYTHONDONTWRITEBYTECODE=1 /usr/bin/python3 -m pytest \
   -p ecsim.pytest_plugin -p no:cacheprovider -q "$work/test_installed.py"
 INSIDE
 unshare --mount --net --propagation private sh -c '
