@@ -71,6 +71,11 @@ cmake -S "$work/user-project" -B "$work/user-build" -DCMAKE_PREFIX_PATH="$usr" \
   ctest --test-dir "$work/user-build" --output-on-failure >>"$work/user.log" 2>&1 ||
   { cat "$work/user.log"; exit 1; }
 echo "user project against the package: ok"
+# The Python module from the package, its pytest fixtures on the installed demo network.
+printf '%s\n' 'def test_installed(ecsim_network, ecsim_master):' \
+  '    assert ecsim_network.slave("DO1").state == "OP"' >"$work/test_installed.py"
+cd "$work" && PYTHONPATH="$usr/lib/python3/dist-packages" PYTHONDONTWRITEBYTECODE=1 /usr/bin/python3 -m pytest \
+  -p ecsim.pytest_plugin -p no:cacheprovider -q "$work/test_installed.py"
 INSIDE
 unshare --mount --net --propagation private sh -c '
   mount -t tmpfs ecsim-hidden "$1" && mount -t tmpfs ecsim-hidden "$2" && exec sh "$3" "$4" "$5"' \
