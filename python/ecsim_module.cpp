@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "embed/simulated_network.hpp"
+#include "embed/slave_variables.hpp"
 #include "link/memory_link.hpp"
 #include "link/netns.hpp"
 #include "link/raw_socket_link.hpp"
@@ -30,7 +31,6 @@
 #include "master/variables.hpp"
 #include "protocol/closest_name.hpp"
 #include "protocol/sdo_info.hpp"
-#include "slavesim/process_data.hpp"
 #include "topology/faults.hpp"
 #include "topology/slave_names.hpp"
 
@@ -348,22 +348,22 @@ void Slave::writeEntry(std::uint16_t index, std::uint8_t subindex, const py::han
   check(slave_.writeEntry(index, subindex, bytes));
 }
 
-// The entries the slave's current PDO assignment maps, named as the dictionary names them
-// (a VAR object's entry by the object's name) and always as "0xIIII:SS". Called with the lock.
+// The entries the slave's current PDO mapping maps, named as a master names them and as
+// `ecsim ctl get` does (embed/slave_variables.hpp: one naming rule), and always as
+// "0xIIII:SS". Called with the lock.
 std::vector<Slave::Named> Slave::processEntries() {
-  const auto* od = slave_.dictionary();
-  if (od == nullptr) throw std::runtime_error("slave '" + name() + "' has no process data");
-  auto layout = take(slavesim::computeProcessDataLayout(*od));
+  if (slave_.dictionary() == nullptr) {
+    throw std::runtime_error("slave '" + name() + "' has no process data");
+  }
+  auto& segment = net_->sim().segment();
+  const auto order = topology::busOrder(segment);
+  std::size_t bus = order.size();
+  for (std::size_t p = 0; p < order.size(); ++p) {
+    if (order[p] == slave_.position()) bus = p;
+  }
   std::vector<Named> out;
-  for (const auto& sm : layout) {
-    for (const auto& m : sm.entries) {
-      if (m.isPadding()) continue;
-      const auto* object = od->find(m.index);
-      const auto* e = od->findEntry(m.index, m.subindex);
-      if (object == nullptr || e == nullptr) continue;
-      const bool byObject = object->code == ObjectCode::kVar || e->name.empty();
-      out.push_back({byObject ? object->name : e->name, m.index, m.subindex});
-    }
+  for (auto& v : embed::slaveVariables(segment)) {
+    if (v.position == bus) out.push_back({std::move(v.entry), v.index, v.subindex});
   }
   return out;
 }

@@ -17,7 +17,7 @@
 #include "link/fd.hpp"
 #include "protocol/registers.hpp"
 #include "slavesim/esi_slave.hpp"
-#include "tools/ecsim/slave_variables.hpp"
+#include "embed/slave_variables.hpp"
 #include "topology/network_builder.hpp"
 
 namespace ecsim::tools {
@@ -59,7 +59,7 @@ class ControlApiTest : public ::testing::Test {
 };
 
 TEST_F(ControlApiTest, SlaveSideNamesAreTheMastersNames) {
-  const auto vars = slaveVariables(*network_.segment);
+  const auto vars = embed::slaveVariables(*network_.segment);
   auto out8 = master::findVariable(vars, "DO1.Output 8");
   ASSERT_TRUE(out8.ok()) << out8.error().message();
   EXPECT_TRUE(out8->output);

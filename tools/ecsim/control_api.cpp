@@ -14,7 +14,7 @@
 #include "protocol/registers.hpp"
 #include "slavesim/coe/data_types.hpp"
 #include "slavesim/esi_slave.hpp"
-#include "tools/ecsim/slave_variables.hpp"
+#include "embed/slave_variables.hpp"
 #include "topology/slave_names.hpp"
 
 namespace ecsim::tools {
@@ -354,7 +354,7 @@ std::string ControlApi::answerJson(std::string_view line, ClientId client, SimTi
   } else if (request.contains("slave")) {
     return failure("give \"name\" alone, or \"slave\" with \"entry\"");
   }
-  const auto variables = slaveVariables(segment);
+  const auto variables = embed::slaveVariables(segment);
   auto found = master::findVariable(variables, name);
   if (!found.ok()) return failure(found.error().context);
   const std::size_t slaveIndex = order[found->position];

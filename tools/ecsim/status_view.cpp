@@ -9,7 +9,7 @@
 #include "protocol/registers.hpp"
 #include "slavesim/coe/data_types.hpp"
 #include "slavesim/esi_slave.hpp"
-#include "tools/ecsim/slave_variables.hpp"
+#include "embed/slave_variables.hpp"
 #include "topology/slave_names.hpp"
 
 namespace ecsim::tools {
@@ -84,7 +84,7 @@ StatusSnapshot takeStatusSnapshot(topology::Segment& segment,
   snap.framesPerSecond = framesPerSecond;
   snap.lastRoundTrip = counters.lastRoundTrip;
   // Named as the control socket and a master name them, in bus order.
-  const std::vector<master::VariableInfo> variables = slaveVariables(segment);
+  const std::vector<master::VariableInfo> variables = embed::slaveVariables(segment);
   const std::vector<std::size_t> order = topology::busOrder(segment);
   for (std::size_t i = 0; i < segment.size(); ++i) {
     slavesim::Slave& slave = segment.slave(i);

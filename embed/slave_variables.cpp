@@ -1,4 +1,4 @@
-#include "tools/ecsim/slave_variables.hpp"
+#include "embed/slave_variables.hpp"
 
 #include <fmt/core.h>
 
@@ -8,7 +8,7 @@
 #include "slavesim/esi_slave.hpp"
 #include "topology/slave_names.hpp"
 
-namespace ecsim::tools {
+namespace ecsim::embed {
 namespace {
 
 std::string hexIndex(std::uint16_t index, std::uint8_t subindex) {
@@ -80,4 +80,4 @@ std::vector<master::VariableInfo> slaveVariables(topology::Segment& segment) {
   return out;
 }
 
-}  // namespace ecsim::tools
+}  // namespace ecsim::embed
