@@ -2,11 +2,13 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <charconv>
 #include <fstream>
 #include <sstream>
 
 #include "config/xml_util.hpp"
+#include "protocol/closest_name.hpp"
 #include "protocol/read_file.hpp"
 
 namespace ecsim {
@@ -71,9 +73,11 @@ const xml::Names kTopologyNames{{"name"}, {"Master", "Slave", "Link"}, {"Master"
 const xml::Names kMasterNames{{"cable"}};
 const xml::Names kSlaveNames{{"name", "esi", "product", "revision", "device", "eeprom", "esc",
                               "dc", "processingDelayNs", "forwardingDelayNs", "stateFile",
-                              "modules"},
+                              "modules", "model"},
                              {"Clock", "Input", "Param", "Module"},
                              {"Clock"}};
+// <Slave model="...">: the device models a topology may choose (docs/devices.md).
+const std::vector<std::string_view> kModelNames{"cia402", "none"};
 const xml::Names kClockNames{{"offsetNs", "driftPpm"}};
 const xml::Names kInputNames{{"entry", "value"}};
 const xml::Names kParamNames{{"name", "value"}};
@@ -125,6 +129,16 @@ Result<TopologySlave> parseSlave(const xml::Context& ctx, const Element* e,
         s.driftPpm, attrDouble(ctx, clock, "driftPpm", 0.0, -kMaxDriftPpm, kMaxDriftPpm, " ppm"));
   }
   if (const char* state = e->Attribute("stateFile")) s.stateFile = folder / state;
+  if (const char* model = e->Attribute("model")) {
+    if (std::find(kModelNames.begin(), kModelNames.end(), std::string_view(model)) ==
+        kModelNames.end()) {
+      return ctx.error(e, unknownNameText("model", model, kModelNames, " on <Slave>"));
+    }
+    if (s.esiFile.empty()) {
+      return ctx.error(e, "Slave '" + s.name + "': model= needs a device from an ESI file (esi=)");
+    }
+    s.model = model;
+  }
   s.folder = folder;
   for (const Element* in : xml::Children(e, "Input")) {
     TopologyInput input;

@@ -63,6 +63,8 @@ struct TopologySlave {
   double driftPpm{0.0};
   std::vector<TopologyInput> inputs;
   std::filesystem::path stateFile;    // persistent device state (e.g. absolute encoder)
+  // The device model (model="cia402|none"); empty: chosen from the ESI (docs/devices.md).
+  std::string model;
   std::vector<TopologyParam> params;  // device model parameters, in the written order
   std::filesystem::path folder;       // the topology file's folder (for files params name)
   // Modular devices: the modules in the slots (none given: the slots' default modules), and

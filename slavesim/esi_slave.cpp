@@ -109,8 +109,11 @@ Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiDevice& device, std::st
   if (options.deviceModels) {
     devices::DeviceModelOptions modelOptions = options.models;
     if (!options.stateFile.empty()) modelOptions.stateFile = options.stateFile;
-    const devices::DeviceModelKind kind =
-        devices::deviceModelFor(sii.identity.vendorId, sii.identity.productCode, device.profileNo);
+    const bool driveObjects =
+        od->findEntry(devices::cia402::obj::kControlword, 0) != nullptr &&
+        od->findEntry(devices::cia402::obj::kStatusword, 0) != nullptr;
+    const devices::DeviceModelKind kind = options.model.value_or(devices::deviceModelFor(
+        sii.identity.vendorId, sii.identity.productCode, device.profileNo, driveObjects));
     ECSIM_TRY(devices::attachDeviceModel(*pd, kind, modelOptions));
     // A power cycle re-creates the model as built here (plus what outlives the power).
     pd->setRestart([kind, modelOptions](ProcessDataDevice& d) {
@@ -129,8 +132,9 @@ Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiDevice& device, std::st
     slave->setMailboxServer(std::make_unique<coe::CoeServer>(od, coeOptions));
   }
   slave->setDevice(std::move(pd));
-  if (devices::Cia402Drive* drive = devices::driveOf(*slave);
-      drive != nullptr && !options.models.emergencies) {
+  for (unsigned axis = 0; !options.models.emergencies; ++axis) {
+    devices::Cia402Drive* drive = devices::driveOf(*slave, axis);
+    if (drive == nullptr) break;
     drive->setEmergencySink(emergencySinkOf(*slave));
   }
   return slave;

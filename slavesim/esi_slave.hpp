@@ -9,7 +9,8 @@
 //              has none) get "unsupported protocol" mailbox error replies;
 //   device     ProcessDataDevice over the same dictionary (also for SII-only slaves, whose
 //              dictionary no mailbox reaches); ESI Virtual SMs are neither checked nor copied;
-//              ecsim's own devices get their model (IO terminal, CiA 402 drive) as its
+//              ecsim's own devices get their model (IO terminal, CiA 402 drive), and any
+//              device whose ESI describes a CiA 402 axis a drive per axis, as its
 //              application, see devices/device_models.hpp.
 // Modular devices come with their modules already in `device` (config/esi_modules.hpp, done by
 // the topology builder). Bootstrap (BOOT state) is not modelled.
@@ -42,6 +43,8 @@ struct EsiSlaveOptions {
   bool deviceNameFirst{true};
   // Attach the device model devices::deviceModelFor() names (false: plain process data).
   bool deviceModels{true};
+  // The model a topology names (model="cia402|none"); unset: devices::deviceModelFor's choice.
+  std::optional<devices::DeviceModelKind> model;
   // Persistent device state (a drive's shaft position), TopologySlave::stateFile; when set it
   // wins over models.stateFile.
   std::filesystem::path stateFile;

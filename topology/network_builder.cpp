@@ -81,10 +81,20 @@ Result<std::unique_ptr<slavesim::Slave>> SlaveFactory::make(const TopologySlave&
   options.escType = esc;
   options.serial = static_cast<std::uint32_t>(entry.line);
   options.stateFile = entry.stateFile;
+  if (!entry.model.empty()) {
+    options.model = slavesim::devices::deviceModelByName(entry.model);
+    if (!options.model) return at(entry, "unknown model '" + entry.model + "'");
+  }
   if (!entry.params.empty()) {
-    if (slavesim::devices::deviceModelFor(file.vendor.id, *entry.productCode, device->profileNo) ==
+    const bool driveObjects = device->dictionary.findObject(slavesim::devices::cia402::obj::
+                                                                kControlword) != nullptr &&
+                              device->dictionary.findObject(
+                                  slavesim::devices::cia402::obj::kStatusword) != nullptr;
+    if (options.model.value_or(slavesim::devices::deviceModelFor(
+            file.vendor.id, *entry.productCode, device->profileNo, driveObjects)) ==
         slavesim::devices::DeviceModelKind::kNone) {
-      return at(entry, "Param given, but this device has no model of ecsim with parameters");
+      return at(entry, "Param given, but this device has no model of ecsim with parameters" +
+                           std::string(entry.model == "none" ? " (model=\"none\")" : ""));
     }
     std::vector<slavesim::devices::DeviceParam> params;
     for (const auto& p : entry.params) params.push_back({p.name, p.value, p.line});
@@ -97,7 +107,11 @@ Result<std::unique_ptr<slavesim::Slave>> SlaveFactory::make(const TopologySlave&
   std::vector<std::string> notes;
   options.warnings = &notes;
   auto slave = slavesim::makeSlaveFromEsi(file, configured, entry.name, options);
-  if (!slave.ok()) return slave;
+  if (!slave.ok()) {
+    Error e = slave.takeError();
+    e.context = "line " + std::to_string(entry.line) + ": " + e.context;
+    return e;
+  }
   for (auto& n : notes) {
     warnings_.push_back("slave '" + entry.name + "' (" + entry.esiFile.string() + "): " +
                         std::move(n));

@@ -3,10 +3,12 @@
 #include "slavesim/devices/cia402_drive.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <limits>
 #include <numbers>
 
+#include "slavesim/coe/standard_objects.hpp"
 #include "slavesim/devices/device_state.hpp"
 #include "slavesim/devices/error_register.hpp"
 
@@ -21,6 +23,23 @@ namespace {
 constexpr SimTime kMaxCatchUp = 10 * kNsPerSecond;
 constexpr std::uint64_t kFollowingErrorOff = 0xFFFFFFFFu;
 constexpr std::int64_t kDefaultMaxTorquePerMille = 3000;
+
+// ETG.6010 multi-axis layout: each further axis has its profile objects 0x800 higher.
+constexpr std::uint16_t kAxisIndexStep = 0x800;
+constexpr std::uint16_t kFirstProfileIndex = 0x6000;
+constexpr std::uint16_t kRxPdoFirst = 0x1600;
+constexpr std::uint16_t kRxPdoLast = 0x17FF;
+
+// Whether any RxPDO mapping object of the dictionary maps `index`.
+bool rxPdoMaps(const coe::ObjectDictionary& od, std::uint16_t index) {
+  for (std::uint32_t pdo = kRxPdoFirst; pdo <= kRxPdoLast; ++pdo) {
+    if (od.findEntry(static_cast<std::uint16_t>(pdo), 0) == nullptr) continue;
+    for (const auto& m : coe::mappedObjects(od, static_cast<std::uint16_t>(pdo))) {
+      if (m.index == index) return true;
+    }
+  }
+  return false;
+}
 
 std::int32_t wrap32(std::int64_t v) {
   return static_cast<std::int32_t>(static_cast<std::uint32_t>(static_cast<std::uint64_t>(v)));
@@ -43,14 +62,28 @@ Result<std::unique_ptr<Cia402Drive>> Cia402Drive::create(coe::ObjectDictionary& 
 
 Status Cia402Drive::init() {
   using namespace cia402::obj;
+  const auto shift = static_cast<std::uint16_t>(params_.axisNumber * kAxisIndexStep);
+  auto at = [shift](std::uint16_t index) {
+    return index >= kFirstProfileIndex ? static_cast<std::uint16_t>(index + shift) : index;
+  };
   for (std::uint16_t index : {kControlword, kStatusword, kModesOfOperation,
                               kModesOfOperationDisplay, kPositionActualValue}) {
-    if (od_.findEntry(index, 0) == nullptr) {
-      return makeError(ErrorCode::kNotFound,
-                       "CiA 402 drive: dictionary has no object " + std::to_string(index));
+    if (od_.findEntry(at(index), 0) == nullptr) {
+      char text[80];
+      std::snprintf(text, sizeof text, "CiA 402 drive (axis %u): dictionary has no object 0x%04X",
+                    params_.axisNumber, static_cast<unsigned>(at(index)));
+      return makeError(ErrorCode::kNotFound, text);
     }
   }
-  auto ref = [&](std::uint16_t index, std::uint8_t sub = 0) { return ObjectRef(od_, index, sub); };
+  auto ref = [&](std::uint16_t index, std::uint8_t sub = 0) {
+    return ObjectRef(od_, at(index), sub);
+  };
+  // The target the vendor's PDOs carry: 0x607A / 0x60FF, or the demand values 0x6062 / 0x606B
+  // where only those are mapped.
+  auto target = [&](std::uint16_t standard, std::uint16_t demand) {
+    return !rxPdoMaps(od_, at(standard)) && rxPdoMaps(od_, at(demand)) ? ref(demand)
+                                                                        : ref(standard);
+  };
   obj_.errorCode = ref(kErrorCode);
   obj_.controlword = ref(kControlword);
   obj_.statusword = ref(kStatusword);
@@ -64,7 +97,7 @@ Status Cia402Drive::init() {
   obj_.targetTorque = ref(kTargetTorque);
   obj_.maxTorque = ref(kMaxTorque);
   obj_.torqueActual = ref(kTorqueActualValue);
-  obj_.targetPosition = ref(kTargetPosition);
+  obj_.targetPosition = target(kTargetPosition, kPositionDemandValue);
   obj_.limitMin = ref(kSoftwarePositionLimit, 1);
   obj_.limitMax = ref(kSoftwarePositionLimit, 2);
   obj_.maxMotorSpeed = ref(kMaxMotorSpeed);
@@ -78,12 +111,25 @@ Status Cia402Drive::init() {
   obj_.ipValue = ref(kInterpolationTimePeriod, 1);
   obj_.ipIndex = ref(kInterpolationTimePeriod, 2);
   obj_.feActual = ref(kFollowingErrorActualValue);
-  obj_.targetVelocity = ref(kTargetVelocity);
+  obj_.targetVelocity = target(kTargetVelocity, kVelocityDemandValue);
   obj_.supportedModes = ref(kSupportedDriveModes);
   obj_.errorRegister = ref(error_register::kIndex);
+  std::optional<std::int8_t> initialMode = params_.initialMode;
+  if (!initialMode && obj_.supportedModes && obj_.supportedModes.getUnsigned() == 0 &&
+      !rxPdoMaps(od_, at(kModesOfOperation)) && rxPdoMaps(od_, at(kTargetPosition))) {
+    initialMode = static_cast<std::int8_t>(cia402::Mode::kCyclicSyncPosition);
+  }
+  if (initialMode) obj_.mode.set(*initialMode);
   if (params_.followingErrorWindow) obj_.feWindow.set(*params_.followingErrorWindow);
   if (params_.followingErrorTimeoutMs) obj_.feTimeout.set(*params_.followingErrorTimeoutMs);
-  if (params_.maxTorquePerMille) obj_.maxTorque.set(*params_.maxTorquePerMille);
+  if (params_.maxTorquePerMille) {
+    obj_.maxTorque.set(*params_.maxTorquePerMille);
+  } else if (obj_.maxTorque && obj_.maxTorque.get() == 0) {
+    // A power-up value of 0 (an object the ESI gives no default, or one made up for a PDO
+    // entry the dictionary lacks, as the AX2000's 0x6072) would leave the motor without
+    // torque: take it as unset.
+    obj_.maxTorque.set(kDefaultMaxTorquePerMille);
+  }
 
   double angle = params_.initialShaftAngle;
   if (!params_.stateFile.empty()) {
@@ -316,8 +362,9 @@ void Cia402Drive::injectFault(std::uint16_t code) {
 
 void Cia402Drive::switchMode(std::int8_t requested) {
   constexpr std::uint32_t kImplemented = 0x3A5;  // PP, PV, HM, CSP, CSV, CST
-  const std::uint32_t supported =
-      static_cast<std::uint32_t>(obj_.supportedModes.getUnsigned(kImplemented)) & kImplemented;
+  auto listed = static_cast<std::uint32_t>(obj_.supportedModes.getUnsigned(kImplemented));
+  if (listed == 0) listed = kImplemented;  // a placeholder 0 (SOES ESIs) states nothing
+  const std::uint32_t supported = listed & kImplemented;
   if ((cia402::supportedModeBit(requested) & supported) == 0) return;  // refused: keep the mode
   mode_ = requested;
   startMode();

@@ -11,12 +11,17 @@
 // (sync()), so outputs act and inputs are latched at the pulses, and step() leaves the model
 // alone; without SYNC0 the drive free-runs on step() as described.
 //
+// The objects are found by index in whatever dictionary the device has (ecsim's own ESI or a
+// vendor's), moved by DriveParams::axis * 0x800 for the further axes of a multi-axis device.
+// A vendor whose RxPDOs map the demand values 0x6062 / 0x606B rather than 0x607A / 0x60FF
+// (the Beckhoff AX2000's synchronous PDOs 0x1701-0x1708) gets those as its targets.
+//
 // Behaviour, in the terms of cia402.hpp:
 //  - the controlword is obeyed in OP only. Leaving OP while the power stage is on is a
 //    communication fault (0x8100): fault reaction, then Fault. Not ready to switch on lasts
 //    DriveParams::initTime after the first step.
 //  - modes (0x6060, shown in 0x6061 once active; a mode 0x6502 does not list is refused and
-//    the previous one stays): CSP (target position interpolated linearly over the 0x60C2
+//    the previous one stays; a 0x6502 of 0 lists nothing and counts as "all implemented"): CSP (target position interpolated linearly over the 0x60C2
 //    period, its slope as velocity feed-forward), CSV, CST (0x6071 per mille of rated torque),
 //    PP (bit 4 new set-point with acknowledge in bit 12, bit 5 change immediately, bit 6
 //    relative, one buffered set-point, 0x6081/0x6083/0x6084), PV (0x60FF ramped with
@@ -81,10 +86,18 @@ struct DriveParams {
   std::filesystem::path stateFile;               // empty: nothing kept
   SimTime stateSaveInterval{100 * kNsPerMs};     // periodic saves while moving; 0: none
   // Initial values of the dictionary's 0x6065 (counts), 0x6066 (ms) and 0x6072 (per mille);
-  // unset: the ESI defaults.
+  // unset: the ESI defaults (a 0x6072 of 0 at power-up counts as unset: 300 %).
   std::optional<std::uint32_t> followingErrorWindow;
   std::optional<std::uint16_t> followingErrorTimeoutMs;
   std::optional<std::uint16_t> maxTorquePerMille;
+  // Which CiA 402 axis of a multi-axis device (ETG.6010: axis n has its profile objects at
+  // 0x6000-0x67FF + n * 0x800; 0x603F-0x67FF objects of axis 0 move, 0x1001 does not).
+  unsigned axisNumber{0};
+  // The mode of operation at power-up (0x6060), e.g. 8 (CSP) for a device whose PDOs carry no
+  // 0x6060 and whose 0x6060 a master cannot write. Unset: the dictionary's value, except for
+  // a fixed-mode CSP device (0x6502 lists no mode, the RxPDOs map 0x607A but not 0x6060, as
+  // the SOES CiA 402 example STMBL_ECAT): CSP.
+  std::optional<std::int8_t> initialMode;
 };
 
 // Where a drive's emergency messages go (the slave's CoE server, coe::CoeServer::pushEmergency).

@@ -6,6 +6,7 @@
 #include <optional>
 #include <string_view>
 
+#include "slavesim/coe/standard_objects.hpp"
 #include "slavesim/devices/device_params.hpp"
 #include "slavesim/generic_slave.hpp"
 
@@ -22,6 +23,9 @@ constexpr std::uint32_t kBeckhoffVendorId = 0x00000002;
 constexpr std::uint32_t kBeckhoffEj5002 = 0x138A2852;
 constexpr std::uint32_t kProfileDrive = 402;
 constexpr std::uint16_t kEncoderResolution = 0x2011;
+constexpr std::uint8_t kIdentityVendorSub = 1;  // 0x1018:01 vendor id
+constexpr std::uint16_t kAxisIndexStep = 0x800;  // ETG.6010 multi-axis layout
+constexpr unsigned kMaxAxes = 8;
 
 template <typename T>
 Status install(ProcessDataDevice& device, Result<std::unique_ptr<T>> model) {
@@ -36,6 +40,25 @@ Status installDrive(ProcessDataDevice& device, Result<std::unique_ptr<T>> model,
   if (!model.ok()) return model.takeError();
   (*model)->setEmergencySink(emergencies);
   device.setApplication(std::move(model).value());
+  return okStatus();
+}
+
+// One drive per axis of the dictionary: a Cia402Drive for one, a MultiAxisDrive for more.
+Status installDrives(ProcessDataDevice& device, const DriveParams& drive,
+                     const EmergencySink& emergencies) {
+  coe::ObjectDictionary& od = device.dictionary();
+  const unsigned count = cia402AxisCount(od);
+  if (count <= 1) return installDrive(device, Cia402Drive::create(od, drive), emergencies);
+  std::vector<std::unique_ptr<Cia402Drive>> axes;
+  for (unsigned n = 0; n < count; ++n) {
+    DriveParams params = drive;
+    params.axisNumber = n;
+    if (n > 0) params.stateFile.clear();  // the state file is axis 0's
+    ECSIM_ASSIGN_OR_RETURN(auto axis, Cia402Drive::create(od, params));
+    axis->setEmergencySink(emergencies);
+    axes.push_back(std::move(axis));
+  }
+  device.setApplication(std::make_unique<MultiAxisDrive>(std::move(axes)));
   return okStatus();
 }
 
@@ -55,11 +78,12 @@ Status applyScripts(Terminal& terminal, const std::vector<std::pair<unsigned, Si
 }  // namespace
 
 DeviceModelKind deviceModelFor(std::uint32_t vendorId, std::uint32_t productCode,
-                               std::optional<std::uint32_t> profileNo) {
+                               std::optional<std::uint32_t> profileNo, bool hasDriveObjects) {
   if (vendorId == kBeckhoffVendorId && productCode == kBeckhoffEj5002) {
     return DeviceModelKind::kSsiEncoder;
   }
-  if (vendorId != kEcsimVendorId) return DeviceModelKind::kNone;
+  const bool drive = profileNo ? *profileNo == kProfileDrive : hasDriveObjects;
+  if (vendorId != kEcsimVendorId) return drive ? DeviceModelKind::kCia402Drive : DeviceModelKind::kNone;
   switch (productCode) {
     case kProductDigitalInputs:
       return DeviceModelKind::kDigitalInputs;
@@ -76,8 +100,28 @@ DeviceModelKind deviceModelFor(std::uint32_t vendorId, std::uint32_t productCode
     default:
       break;
   }
-  if (profileNo && *profileNo == kProfileDrive) return DeviceModelKind::kCia402Drive;
-  return DeviceModelKind::kNone;
+  return drive ? DeviceModelKind::kCia402Drive : DeviceModelKind::kNone;
+}
+
+std::optional<DeviceModelKind> deviceModelByName(std::string_view name) {
+  if (name == "cia402") return DeviceModelKind::kCia402Drive;
+  if (name == "none") return DeviceModelKind::kNone;
+  return std::nullopt;
+}
+
+std::vector<std::string> deviceModelNames() { return {"cia402", "none"}; }
+
+unsigned cia402AxisCount(const coe::ObjectDictionary& od) {
+  unsigned n = 0;
+  while (n < kMaxAxes) {
+    const auto shift = static_cast<std::uint16_t>(n * kAxisIndexStep);
+    if (od.findEntry(static_cast<std::uint16_t>(cia402::obj::kControlword + shift), 0) == nullptr ||
+        od.findEntry(static_cast<std::uint16_t>(cia402::obj::kStatusword + shift), 0) == nullptr) {
+      break;
+    }
+    ++n;
+  }
+  return n;
 }
 
 Status attachDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,
@@ -91,11 +135,16 @@ Status attachDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,
   }
   DriveParams drive = options.drive;
   if (!options.stateFile.empty()) drive.stateFile = options.stateFile;
+  // 0x2011 is ecsim's encoder resolution object only in ecsim's own devices (0x1018:01); a
+  // vendor's 0x2011 is the vendor's (the Ingenia EVS-NET-01's is a status word).
+  const auto vendor = od.get<std::uint32_t>(coe::kIdentityIndex, kIdentityVendorSub);
+  const bool ecsimResolution = vendor.ok() && *vendor == kEcsimVendorId;
   if (options.encoderResolutionSet) {
-    if (od.findEntry(kEncoderResolution, 0) != nullptr) {
+    if (ecsimResolution && od.findEntry(kEncoderResolution, 0) != nullptr) {
       ECSIM_TRY(od.set<std::uint32_t>(kEncoderResolution, 0, drive.encoder.countsPerRevolution));
     }
-  } else if (const auto cpr = od.get<std::uint32_t>(kEncoderResolution, 0); cpr.ok() && *cpr > 0) {
+  } else if (const auto cpr = od.get<std::uint32_t>(kEncoderResolution, 0);
+             ecsimResolution && cpr.ok() && *cpr > 0) {
     drive.encoder.countsPerRevolution = *cpr;
   }
   switch (kind) {
@@ -116,7 +165,7 @@ Status attachDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,
       return okStatus();
     }
     case DeviceModelKind::kCia402Drive:
-      return installDrive(device, Cia402Drive::create(od, drive), options.emergencies);
+      return installDrives(device, drive, options.emergencies);
     case DeviceModelKind::kRobotDrive:
       return installDrive(device, RobotDrive::create(od, drive), options.emergencies);
     case DeviceModelKind::kSsiEncoder: {
@@ -171,8 +220,14 @@ Application* deviceModelOf(Slave& slave) {
   return pd == nullptr ? nullptr : pd->application();
 }
 
-Cia402Drive* driveOf(Slave& slave) {
-  return dynamic_cast<Cia402Drive*>(deviceModelOf(slave));
+Cia402Drive* driveOf(Slave& slave) { return driveOf(slave, 0); }
+
+Cia402Drive* driveOf(Slave& slave, unsigned axis) {
+  Application* model = deviceModelOf(slave);
+  if (auto* multi = dynamic_cast<MultiAxisDrive*>(model)) {
+    return axis < multi->axes() ? &multi->axis(axis) : nullptr;
+  }
+  return axis == 0 ? dynamic_cast<Cia402Drive*>(model) : nullptr;
 }
 
 RobotDrive* robotDriveOf(Slave& slave) {
@@ -300,6 +355,8 @@ Result<bool> applyPlain(DeviceModelOptions& o, const DeviceParam& p) {
     ECSIM_ASSIGN_OR_RETURN(o.drive.followingErrorTimeoutMs, integer<std::uint16_t>(p, 0, 0xFFFF));
   } else if (n == "drive.torqueLimit") {
     ECSIM_ASSIGN_OR_RETURN(o.drive.maxTorquePerMille, integer<std::uint16_t>(p, 0, 0xFFFF));
+  } else if (n == "drive.mode") {
+    ECSIM_ASSIGN_OR_RETURN(o.drive.initialMode, integer<std::int8_t>(p, -128, 127));
   } else if (n == "drive.homeOffset") {
     ECSIM_ASSIGN_OR_RETURN(o.drive.homeOffset, integer<std::int64_t>(p, -(1ll << 52), 1ll << 52));
   } else if (n == "drive.initTimeMs") {

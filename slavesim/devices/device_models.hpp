@@ -9,15 +9,21 @@
 //   ECS7201 (0x7201)            Cia402Drive
 //   ECS7211 (0x7211)            RobotDrive
 //   ECS5001 (0x5001)            SsiEncoderTerminal (examples/esi/ecsim_encoders.xml)
-// for the ecsim vendor id (0x00000E5C); an ecsim device with CiA 402 profile (ProfileNo 402)
-// and another product code also gets a Cia402Drive. Devices of other vendors keep the plain
-// ProcessDataDevice (their dictionaries are theirs to define), except the Beckhoff EJ5002
-// (vendor 2, 0x138A2852), whose SSI channel layout the SsiEncoderTerminal follows.
+// for the ecsim vendor id (0x00000E5C), and the Beckhoff EJ5002 (vendor 2, 0x138A2852), whose
+// SSI channel layout the SsiEncoderTerminal follows. Any other device, of any vendor, gets a
+// CiA 402 drive when its ESI says ProfileNo 402, or says no profile and its dictionary has the
+// controlword 0x6040 and statusword 0x6041 (a device of another profile, e.g. 5001 MDP, may use
+// 0x6040 for something else). The drive binds to the device's own objects and PDO entries; a
+// device with further axes (0x6840/0x6841, 0x7040/0x7041, ...) gets one drive per axis
+// (MultiAxisDrive). Other devices keep the plain ProcessDataDevice. A topology's
+// model="cia402|none" overrides the choice (DeviceModelKind by name: deviceModelByName).
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -25,6 +31,7 @@
 #include "slavesim/devices/cia402_drive.hpp"
 #include "slavesim/devices/encoder_terminal.hpp"
 #include "slavesim/devices/io_terminals.hpp"
+#include "slavesim/devices/multi_axis_drive.hpp"
 #include "slavesim/devices/robot_drive.hpp"
 #include "slavesim/process_data.hpp"
 #include "slavesim/slave.hpp"
@@ -41,8 +48,19 @@ enum class DeviceModelKind : std::uint8_t {
   kSsiEncoder,
 };
 
+// hasDriveObjects: the device's dictionary has 0x6040 and 0x6041.
 DeviceModelKind deviceModelFor(std::uint32_t vendorId, std::uint32_t productCode,
-                               std::optional<std::uint32_t> profileNo = std::nullopt);
+                               std::optional<std::uint32_t> profileNo = std::nullopt,
+                               bool hasDriveObjects = false);
+
+// The model a topology's model="NAME" names ("cia402", "none"); nullopt for another name.
+std::optional<DeviceModelKind> deviceModelByName(std::string_view name);
+// The names deviceModelByName takes, for messages.
+std::vector<std::string> deviceModelNames();
+
+// The CiA 402 axes of a dictionary: axis n counts while 0x6040 + n * 0x800 and 0x6041 + n *
+// 0x800 are both present (at most 8, up to 0x9FFF).
+unsigned cia402AxisCount(const coe::ObjectDictionary& od);
 
 struct DeviceModelOptions {
   std::filesystem::path stateFile;  // drives, encoders: where the shaft position is kept
@@ -77,7 +95,8 @@ Status restartDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,
 
 // The model of a slave built by makeSlaveFromEsi (nullptr when it has another or none).
 Application* deviceModelOf(Slave& slave);
-Cia402Drive* driveOf(Slave& slave);  // also a RobotDrive
+Cia402Drive* driveOf(Slave& slave);  // also a RobotDrive; axis 0 of a multi-axis device
+Cia402Drive* driveOf(Slave& slave, unsigned axis);  // nullptr when there is no such axis
 RobotDrive* robotDriveOf(Slave& slave);
 DigitalInputTerminal* digitalInputsOf(Slave& slave);
 DigitalOutputTerminal* digitalOutputsOf(Slave& slave);

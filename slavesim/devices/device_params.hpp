@@ -14,7 +14,8 @@
 //              shaft starts at drive.initialShaftAngle and may be scripted by signal.N (turns)
 //   drive.*    followingErrorWindow (counts, 0x6065), followingErrorTimeout (ms, 0x6066),
 //              torqueLimit (per mille of rated torque, 0x6072), quickStopDeceleration
-//              (counts/s^2), homeOffset (counts), initialShaftAngle (rad), initTimeMs,
+//              (counts/s^2), homeOffset (counts), initialShaftAngle (rad), mode (0x6060 at
+//              power-up, e.g. 8 for CSP), initTimeMs,
 //              faultReactionTimeoutMs, stateSaveIntervalMs (simulated ms between saves of
 //              the stateFile while the shaft moves, default 100; 0: on state changes only)
 //   analog.*   fullScaleVolts, conversionPeriodUs

@@ -325,8 +325,9 @@ const EsiDevice* findDevice(const EsiFile& file, std::string_view type, std::uin
   return nullptr;
 }
 
-std::unique_ptr<slavesim::Slave> build(const EsiFile& file, const EsiDevice& device) {
-  auto slave = slavesim::makeSlaveFromEsi(file, device, device.type);
+std::unique_ptr<slavesim::Slave> build(const EsiFile& file, const EsiDevice& device,
+                                       slavesim::EsiSlaveOptions options = {}) {
+  auto slave = slavesim::makeSlaveFromEsi(file, device, device.type, options);
   EXPECT_TRUE(slave.ok()) << (slave.ok() ? "" : slave.error().message());
   return slave.ok() ? std::move(slave).value() : nullptr;
 }
@@ -341,7 +342,11 @@ TEST(EsiSlave, StmblServoThroughFramesFromSdoToProcessData) {
   ECSIM_REQUIRE_SHARED(path);
   auto file = loadEsiFile(path);
   ASSERT_TRUE(file.ok());
-  auto slave = build(*file, file->devices.at(0));
+  // Static process data (model="none"): the inputs set below stay as set. With its model the
+  // STMBL is a CiA 402 drive (tests/embed/vendor_drive_test.cpp).
+  slavesim::EsiSlaveOptions options;
+  options.model = slavesim::devices::DeviceModelKind::kNone;
+  auto slave = build(*file, file->devices.at(0), options);
   ASSERT_NE(slave, nullptr);
   EXPECT_EQ(slave->esc().type().kind, slavesim::EscKind::kLan9252) << "4 SMs, 2 ports";
   slavesim::coe::ObjectDictionary* od = slavesim::objectDictionaryOf(*slave);
