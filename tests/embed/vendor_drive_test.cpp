@@ -15,12 +15,14 @@
 // the position encoder resolution 0x608F, so the position unit is one encoder count and a turn
 // is the default 2^17 counts, docs/devices.md).
 #include <gtest/gtest.h>
+
 #include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <ostream>
 
 #include "embed/testing/network_fixture.hpp"
 #include "slavesim/devices/device_models.hpp"
@@ -40,6 +42,11 @@ struct VendorDriveCase {
   std::uint16_t txPdo;
   const char* target;  // the target position entry the PDOs carry
 };
+// The ESI file names the case in test names (else gtest prints the struct's bytes, pointers
+// among them, and the ctest name changes from build to build).
+void PrintTo(const VendorDriveCase& c, std::ostream* os) {
+  *os << c.file;
+}
 
 const VendorDriveCase kCases[] = {
     // Ingenia EVS-NET-01: default 0x1600 = 6040, 607A, 60FF, 6060; 0x1A00 the inputs.
@@ -129,8 +136,8 @@ TEST_P(VendorDrive, EnablesAndFollowsACspTurnThroughItsOwnPdos) {
     }
     return false;
   };
-  ASSERT_TRUE(runUntil(0x0000, 0x4F, 0x40)) << "Switch on disabled, sw 0x" << std::hex
-                                            << statusword->get<std::uint16_t>();
+  ASSERT_TRUE(runUntil(0x0000, 0x4F, 0x40))
+      << "Switch on disabled, sw 0x" << std::hex << statusword->get<std::uint16_t>();
   ASSERT_TRUE(runUntil(0x0006, 0x6F, 0x21)) << "Ready to switch on";
   ASSERT_TRUE(runUntil(0x0007, 0x6F, 0x23)) << "Switched on";
   ASSERT_TRUE(runUntil(0x000F, 0x6F, 0x27)) << "Operation enabled";
