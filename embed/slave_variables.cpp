@@ -32,13 +32,13 @@ std::vector<master::VariableInfo> slaveVariables(topology::Segment& segment) {
     if (uses[slave.name()] > 1) slaveName += "_" + std::to_string(position);
     const auto& od = device->dictionary();
     const std::size_t first = out.size();
-    std::map<std::string, int> entryUses;
     std::vector<std::string> pdoNames;
     for (const auto& sm : device->binding().layout()) {
       std::uint32_t bit = 0;
       // Which PDO each entry came from: the SM's assigned PDOs' mappings in order.
       std::vector<std::string> pdoOfEntry;
-      const std::uint16_t assign = static_cast<std::uint16_t>(slavesim::coe::kPdoAssignBase + sm.sm);
+      const std::uint16_t assign =
+          static_cast<std::uint16_t>(slavesim::coe::kPdoAssignBase + sm.sm);
       if (const auto* assigned = od.find(assign)) {
         for (const auto& a : assigned->entries) {
           if (a.subindex == 0) continue;
@@ -65,17 +65,12 @@ std::vector<master::VariableInfo> slaveVariables(topology::Segment& segment) {
           v.subindex = m.subindex;
           v.dataType = e->dataType;
           v.type = master::variableType(e->dataType, m.bitLength);
-          ++entryUses[v.entry];
           out.push_back(std::move(v));
         }
         bit += m.bitLength;
       }
     }
-    for (std::size_t k = first; k < out.size(); ++k) {
-      auto& v = out[k];
-      if (entryUses[v.entry] > 1 && !v.name.empty()) v.entry = v.name + "." + v.entry;
-      v.name = v.slave + "." + v.entry;
-    }
+    master::finishVariableNames(std::span(out).subspan(first));
   }
   return out;
 }

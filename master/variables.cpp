@@ -213,7 +213,6 @@ std::vector<VariableInfo> nameVariables(const ProcessImageLayout& layout,
   std::vector<VariableInfo> out;
   for (const auto& sl : layout.slaves) {
     const std::size_t first = out.size();
-    std::map<std::string, int> entryUses;
     for (const auto& sm : sl.sms) {
       if (sm.setting.length == 0) continue;
       std::uint32_t bit = (sm.logicalStart - layout.logicalBase) * 8;
@@ -233,20 +232,24 @@ std::vector<VariableInfo> nameVariables(const ProcessImageLayout& layout,
             v.subindex = e.subindex;
             v.dataType = e.dataType;
             v.type = variableType(e.dataType, e.bitLength);
-            ++entryUses[v.entry];
             out.push_back(std::move(v));
           }
           bit += e.bitLength;
         }
       }
     }
-    for (std::size_t k = first; k < out.size(); ++k) {
-      VariableInfo& v = out[k];
-      if (entryUses[v.entry] > 1 && !v.name.empty()) v.entry = v.name + "." + v.entry;
-      v.name = v.slave + "." + v.entry;
-    }
+    finishVariableNames(std::span(out).subspan(first));
   }
   return out;
+}
+
+void finishVariableNames(std::span<VariableInfo> slaveVariables) {
+  std::map<std::string, int> entryUses;
+  for (const auto& v : slaveVariables) ++entryUses[v.entry];
+  for (VariableInfo& v : slaveVariables) {
+    if (entryUses[v.entry] > 1 && !v.name.empty()) v.entry = v.name + "." + v.entry;
+    v.name = v.slave + "." + v.entry;
+  }
 }
 
 Result<VariableInfo> findVariable(const std::vector<VariableInfo>& variables,

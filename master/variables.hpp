@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -108,6 +109,11 @@ class PdoVariable {
 };
 
 // Every entry of the layout, named as above.
+// The naming rule's last step for the variables of one slave, `slave` and `entry` set and `name`
+// holding the name of the PDO the entry came from: an entry name two PDOs share becomes
+// "<pdo>.<entry>", and every name "<slave>.<entry>". The master's and the simulated slaves'
+// (embed/slave_variables.hpp) names are made by it, so they are the same names.
+void finishVariableNames(std::span<VariableInfo> slaveVariables);
 std::vector<VariableInfo> nameVariables(const ProcessImageLayout& layout,
                                         const std::vector<SlaveInfo>& slaves);
 // Finds `name` (or an alias as above) among `variables`; kNotFound names the closest variables
