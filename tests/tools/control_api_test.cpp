@@ -14,10 +14,10 @@
 #include <nlohmann/json.hpp>
 
 #include "config/topology_file.hpp"
+#include "embed/slave_variables.hpp"
 #include "link/fd.hpp"
 #include "protocol/registers.hpp"
 #include "slavesim/esi_slave.hpp"
-#include "embed/slave_variables.hpp"
 #include "topology/network_builder.hpp"
 
 namespace ecsim::tools {
@@ -112,6 +112,20 @@ TEST_F(ControlApiTest, ObjectsAndRegisters) {
   }
 }
 
+// A register set through the socket is written from the PDI side, as the slave's firmware
+// writes it: AL Status Code (0x0134) is the PDI's to write (ESC datasheet section II, 0x0134:
+// ECAT read-only, PDI read/write), and the master then reads what was written.
+TEST_F(ControlApiTest, ARegisterIsSetFromThePdiSide) {
+  json j = ask(R"({"op":"set","slave":"DO1","register":"AlStatusCode","value":27})");
+  EXPECT_EQ(j["ok"], true) << j.dump();
+  EXPECT_EQ(j["value"], 27);
+  EXPECT_EQ(slave("DO1").esc().read(reg::kAlStatusCode), 0x001B);
+  EXPECT_EQ(error(R"({"op":"set","slave":"DO1","register":"AlStatusCode","value":70000})"),
+            "DO1 AL Status Code: value 70000 out of range 0..65535");
+  EXPECT_EQ(error(R"({"op":"set","slave":"DO1","register":"AlStatusCode"})"),
+            "op 'set' needs \"value\"");
+}
+
 TEST_F(ControlApiTest, StateListsEverySlaveInBusOrder) {
   json j = ask(R"({"op":"state"})");
   ASSERT_EQ(j["slaves"].size(), 6u) << j.dump();
@@ -144,9 +158,9 @@ TEST_F(ControlApiTest, BadRequestsNameWhatIsWrong) {
             "op 'get' takes no key 'entri'; did you mean 'entry'?");
   EXPECT_EQ(error(R"({"op":"set","slave":"DI1","entry":"Input 2","value":2})"),
             "DI1.Input 2: value 2 out of range 0..1");
-  EXPECT_NE(error(R"({"op":"set","slave":"DO1","entry":"Output 8","value":1})")
-                .find("is an output"),
-            std::string::npos);
+  EXPECT_NE(
+      error(R"({"op":"set","slave":"DO1","entry":"Output 8","value":1})").find("is an output"),
+      std::string::npos);
   EXPECT_EQ(error(R"({"op":"get",)").rfind("malformed JSON at byte 13", 0), 0u);
   EXPECT_NE(error(R"({"op":"get","slave":"DO1","register":"AlStatis"})")
                 .find("did you mean 'AL Status'?"),
@@ -203,8 +217,9 @@ class ControlSubscribeTest : public ControlApiTest {
 };
 
 TEST_F(ControlSubscribeTest, PushesEachChangeOnceAndNothingWithoutOne) {
-  ASSERT_TRUE(client_->sendLine(R"({"op":"subscribe","slave":"DO1","entry":"Output 8"})",
-                                std::chrono::milliseconds(200))
+  ASSERT_TRUE(client_
+                  ->sendLine(R"({"op":"subscribe","slave":"DO1","entry":"Output 8"})",
+                             std::chrono::milliseconds(200))
                   .ok());
   serve();
   json first = next();

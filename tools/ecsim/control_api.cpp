@@ -10,11 +10,11 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "embed/slave_variables.hpp"
 #include "protocol/closest_name.hpp"
 #include "protocol/registers.hpp"
 #include "slavesim/coe/data_types.hpp"
 #include "slavesim/esi_slave.hpp"
-#include "embed/slave_variables.hpp"
 #include "topology/slave_names.hpp"
 
 namespace ecsim::tools {
@@ -26,11 +26,11 @@ using ClientId = topology::ControlServer::ClientId;
 // The ops and the keys each takes ("op" always).
 struct OpKeys {
   std::string_view op;
-  std::array<std::string_view, 5> keys;
+  std::array<std::string_view, 6> keys;
 };
 constexpr std::array<OpKeys, 6> kOps{{
     {"get", {"slave", "entry", "name", "object", "register"}},
-    {"set", {"slave", "entry", "name", "object", "value"}},
+    {"set", {"slave", "entry", "name", "object", "register", "value"}},
     {"state", {}},
     {"faults", {}},
     {"subscribe", {"slave", "entry", "name"}},
@@ -81,9 +81,11 @@ Result<std::uint64_t> encodeValue(const json& value, std::uint16_t dataType,
   using master::VariableType;
   const auto type = master::variableType(dataType, static_cast<std::uint8_t>(bitLength));
   if (type == VariableType::kReal32 || type == VariableType::kReal64) {
-    if (!value.is_number()) return makeError(ErrorCode::kInvalidArgument, what + ": value is not a number");
+    if (!value.is_number())
+      return makeError(ErrorCode::kInvalidArgument, what + ": value is not a number");
     const double d = value.get<double>();
-    if (type == VariableType::kReal32) return std::uint64_t{std::bit_cast<std::uint32_t>(static_cast<float>(d))};
+    if (type == VariableType::kReal32)
+      return std::uint64_t{std::bit_cast<std::uint32_t>(static_cast<float>(d))};
     return std::bit_cast<std::uint64_t>(d);
   }
   json v = value;
@@ -96,13 +98,13 @@ Result<std::uint64_t> encodeValue(const json& value, std::uint16_t dataType,
                         type == VariableType::kInt32 || type == VariableType::kInt64;
   const unsigned bits = std::min<unsigned>(bitLength, 64);
   if (isSigned) {
-    const std::int64_t lo = bits >= 64 ? std::numeric_limits<std::int64_t>::min()
-                                       : -(std::int64_t{1} << (bits - 1));
-    const std::int64_t hi = bits >= 64 ? std::numeric_limits<std::int64_t>::max()
-                                       : (std::int64_t{1} << (bits - 1)) - 1;
+    const std::int64_t lo =
+        bits >= 64 ? std::numeric_limits<std::int64_t>::min() : -(std::int64_t{1} << (bits - 1));
+    const std::int64_t hi =
+        bits >= 64 ? std::numeric_limits<std::int64_t>::max() : (std::int64_t{1} << (bits - 1)) - 1;
     if (v.is_number_unsigned() && v.get<std::uint64_t>() > static_cast<std::uint64_t>(hi)) {
-      return makeError(ErrorCode::kInvalidArgument, fmt::format("{}: value {} out of range {}..{}",
-                                                           what, value.dump(), lo, hi));
+      return makeError(ErrorCode::kInvalidArgument,
+                       fmt::format("{}: value {} out of range {}..{}", what, value.dump(), lo, hi));
     }
     const auto s = v.get<std::int64_t>();
     if (s < lo || s > hi) {
@@ -265,14 +267,14 @@ std::string ControlApi::answerJson(std::string_view line, ClientId client, SimTi
     return failure(answer.substr(answer.rfind("error ", 0) == 0 ? 6 : 0));
   }
 
-  const int targets = static_cast<int>(request.contains("entry")) +
-                      static_cast<int>(request.contains("name")) +
-                      static_cast<int>(request.contains("object")) +
-                      static_cast<int>(request.contains("register"));
+  const int targets =
+      static_cast<int>(request.contains("entry")) + static_cast<int>(request.contains("name")) +
+      static_cast<int>(request.contains("object")) + static_cast<int>(request.contains("register"));
   if (targets != 1) {
     return failure("op '" + op + "' needs one of \"entry\" (with \"slave\"), \"name\"" +
                    (op == "subscribe" ? std::string() : ", \"object\"") +
-                   (op == "get" ? ", \"register\"" : "") + "; got " + std::to_string(targets));
+                   (op == "subscribe" ? std::string() : ", \"register\"") + "; got " +
+                   std::to_string(targets));
   }
   if (op == "set" && !request.contains("value")) return failure("op 'set' needs \"value\"");
 
@@ -296,17 +298,31 @@ std::string ControlApi::answerJson(std::string_view line, ClientId client, SimTi
     if (request.contains("register")) {
       auto r = lookUpRegister(text("register"));
       if (!r.ok()) return failure(r.error().context);
+      if (op == "set") {
+        // Written from the PDI side, as the slave's own firmware writes its ESC (AL status,
+        // AL status code, PDI-owned registers): what the master then reads.
+        const std::string what = text("slave") + " " + std::string(r->name);
+        if (r->width > 8) return failure(what + " is longer than 8 bytes: not settable here");
+        auto raw = encodeValue(request["value"], 0, static_cast<std::uint16_t>(8 * r->width), what);
+        if (!raw.ok()) return failure(raw.error().context);
+        for (unsigned b = 0; b < r->width; ++b) {
+          slave.esc().pdiWrite8(static_cast<std::uint16_t>(r->address + b),
+                                static_cast<std::uint8_t>(*raw >> (8 * b)));
+        }
+      }
       json j{{"ok", true}, {"register", r->name}, {"address", fmt::format("0x{:04X}", r->address)}};
       if (r->width <= 8) {
         std::uint64_t v = 0;
         for (unsigned b = 0; b < r->width; ++b) {
-          v |= std::uint64_t{slave.esc().reg8(static_cast<std::uint16_t>(r->address + b))} << (8 * b);
+          v |= std::uint64_t{slave.esc().reg8(static_cast<std::uint16_t>(r->address + b))}
+               << (8 * b);
         }
         j["value"] = v;
       } else {
         std::string hex;
         for (unsigned b = 0; b < r->width; ++b) {
-          hex += fmt::format("{:02x}", slave.esc().reg8(static_cast<std::uint16_t>(r->address + b)));
+          hex +=
+              fmt::format("{:02x}", slave.esc().reg8(static_cast<std::uint16_t>(r->address + b)));
         }
         j["bytes"] = hex;
       }
@@ -316,7 +332,8 @@ std::string ControlApi::answerJson(std::string_view line, ClientId client, SimTi
     if (od == nullptr) return failure("slave '" + text("slave") + "' has no object dictionary");
     auto where = parseObject(text("object"));
     if (!where) {
-      return failure("object '" + text("object") + "' is not 0xIIII:SS (index and subindex in hex)");
+      return failure("object '" + text("object") +
+                     "' is not 0xIIII:SS (index and subindex in hex)");
     }
     const auto [index, sub] = *where;
     const auto* e = od->findEntry(index, sub);
@@ -328,7 +345,8 @@ std::string ControlApi::answerJson(std::string_view line, ClientId client, SimTi
       if (op == "set") return failure(what + " is longer than 64 bits: not settable here");
       std::string hex;
       for (auto b : e->value) hex += fmt::format("{:02x}", b);
-      return reply({{"ok", true}, {"object", hexIndex(index, sub)}, {"name", e->name}, {"bytes", hex}});
+      return reply(
+          {{"ok", true}, {"object", hexIndex(index, sub)}, {"name", e->name}, {"bytes", hex}});
     }
     if (op == "set") {
       auto raw = encodeValue(request["value"], e->dataType, e->bitLength, what);
@@ -374,15 +392,15 @@ std::string ControlApi::answerJson(std::string_view line, ClientId client, SimTi
       return failure(found->name + ": " + st.error().context);
     }
   }
-  const auto raw = slavesim::coe::readRawValue(od->bytes(found->index, found->subindex),
-                                               found->bitLength);
+  const auto raw =
+      slavesim::coe::readRawValue(od->bytes(found->index, found->subindex), found->bitLength);
   const json value = decodeValue(raw, found->dataType, found->bitLength);
   if (op == "subscribe") {
     std::size_t mine = 0;
     for (const auto& s : subscriptions_) mine += s.client == client ? 1 : 0;
     if (mine >= kMaxSubscriptionsPerClient) {
-      return failure(fmt::format("at most {} subscriptions per connection",
-                                 kMaxSubscriptionsPerClient));
+      return failure(
+          fmt::format("at most {} subscriptions per connection", kMaxSubscriptionsPerClient));
     }
     subscriptions_.push_back({client, *found, slaveIndex, raw});
     return reply({{"ok", true}, {"subscribed", found->name}, {"value", value}});
@@ -395,8 +413,7 @@ std::string ControlApi::answerJson(std::string_view line, ClientId client, SimTi
 }
 
 void ControlApi::publish(topology::ControlServer& server) {
-  std::erase_if(subscriptions_,
-                [&](const Subscription& s) { return !server.connected(s.client); });
+  std::erase_if(subscriptions_, [&](const Subscription& s) { return !server.connected(s.client); });
   for (auto& s : subscriptions_) {
     server.holdOpen(s.client);
     auto* od = slavesim::objectDictionaryOf(network_.segment->slave(s.slave));

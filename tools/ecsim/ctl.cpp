@@ -33,7 +33,8 @@ constexpr std::string_view kQueryHelp =
     "  get SLAVE ENTRY            a process-data entry (\"Output 8\"), or get SLAVE.ENTRY\n"
     "  get SLAVE 0xIIII:SS        an object-dictionary entry (index, subindex in hex)\n"
     "  set SLAVE ENTRY|0xIIII:SS VALUE   an input entry or an object\n"
-    "  reg SLAVE REGISTER         an ESC register by name (AlStatus) or address (0x0130)\n"
+    "  reg SLAVE REGISTER [VALUE] an ESC register by name (AlStatus) or address (0x0130);\n"
+    "                             with VALUE written from the slave's side (its PDI)\n"
     "  state                      every slave's AL state and status code\n"
     "  faults                     the fault actions applied through the socket\n"
     "  subscribe SLAVE ENTRY      print the entry's value at every change (--count N)\n"
@@ -67,31 +68,37 @@ Result<nlohmann::json> queryRequest(const std::vector<std::string>& w) {
     }
     return j;
   }
+  // A value typed on the command line: a JSON number, true/false, or 0x... hex.
+  auto valueOf = [](const std::string& text) -> Result<json> {
+    json value = json::parse(text, nullptr, false);
+    if (!value.is_discarded() && (value.is_number() || value.is_boolean())) return value;
+    const bool hex = text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X');
+    if (!hex) {
+      return makeError(ErrorCode::kInvalidArgument,
+                       "value '" + text + "' is not a number (or true/false, 0x...)");
+    }
+    try {
+      std::size_t used = 0;
+      value = std::stoull(text.substr(2), &used, 16);
+      if (used != text.size() - 2) throw std::invalid_argument("");
+    } catch (const std::exception&) {
+      return makeError(ErrorCode::kInvalidArgument, "value '" + text + "' is not a number");
+    }
+    return value;
+  };
   if (verb == "set") {
     if (n != 3) return usage("set SLAVE ENTRY|0xIIII:SS VALUE");
     json j{{"op", "set"}};
     target(j, w[1], w[2]);
-    json value = json::parse(w[3], nullptr, false);
-    if (value.is_discarded() || !(value.is_number() || value.is_boolean())) {
-      auto hex = w[3].size() > 2 && w[3][0] == '0' && (w[3][1] == 'x' || w[3][1] == 'X');
-      if (!hex) {
-        return makeError(ErrorCode::kInvalidArgument,
-                         "value '" + w[3] + "' is not a number (or true/false, 0x...)");
-      }
-      try {
-        std::size_t used = 0;
-        value = std::stoull(w[3].substr(2), &used, 16);
-        if (used != w[3].size() - 2) throw std::invalid_argument("");
-      } catch (const std::exception&) {
-        return makeError(ErrorCode::kInvalidArgument, "value '" + w[3] + "' is not a number");
-      }
-    }
-    j["value"] = value;
+    ECSIM_ASSIGN_OR_RETURN(j["value"], valueOf(w[3]));
     return j;
   }
   if (verb == "reg") {
-    if (n != 2) return usage("reg SLAVE REGISTER");
-    return json{{"op", "get"}, {"slave", w[1]}, {"register", w[2]}};
+    if (n != 2 && n != 3) return usage("reg SLAVE REGISTER [VALUE]");
+    if (n == 2) return json{{"op", "get"}, {"slave", w[1]}, {"register", w[2]}};
+    json j{{"op", "set"}, {"slave", w[1]}, {"register", w[2]}};
+    ECSIM_ASSIGN_OR_RETURN(j["value"], valueOf(w[3]));
+    return j;
   }
   if (verb == "state" || verb == "faults") {
     if (n != 0) return usage(verb);
