@@ -141,8 +141,10 @@ TEST(NetSetup, SigkilledServeLeavesAPairTheNextUpCleans) {
   ASSERT_TRUE(ns.ok()) << ns.error().message();
   const std::string name = uniqueName() + "k";
   const std::string log = uniqueTempPath("serve_veth_" + name + ".log");
-  auto serve =
-      ns->spawn({kEcsim, "serve", "--veth", name, "--slaves", "2"}, SpawnOptions{log, log});
+  // SIGKILL leaves the control socket behind: in the temporary folder, removed below.
+  const std::string control = uniqueTempPath("serve_veth_" + name + ".sock");
+  auto serve = ns->spawn({kEcsim, "serve", "--veth", name, "--slaves", "2", "--control", control},
+                         SpawnOptions{log, log});
   ASSERT_TRUE(serve.ok());
   // The pair exists once serve says it serves (a start under ASan on a busy machine can take
   // longer than any fixed wait).
@@ -159,6 +161,7 @@ TEST(NetSetup, SigkilledServeLeavesAPairTheNextUpCleans) {
   EXPECT_EQ(down->exitCode, 0);
   EXPECT_FALSE(linkExists(*ns, name));
   EXPECT_FALSE(linkExists(*ns, name + "s"));
+  std::filesystem::remove(control);
   if (!HasFailure()) std::filesystem::remove(log);
 }
 

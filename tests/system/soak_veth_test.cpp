@@ -45,20 +45,31 @@ bool sanitizerReport(const std::string& log) {
 
 class SoakedServer {
  public:
-  explicit SoakedServer(const std::string& tag) : log_(uniqueTempPath("soak_" + tag + ".log")) {
+  // The control socket goes to the temporary folder, removed with the object: a server killed
+  // by a test (SIGKILL) leaves its socket behind, and the default one is in /run/ecsim.
+  explicit SoakedServer(const std::string& tag)
+      : log_(uniqueTempPath("soak_" + tag + ".log")),
+        control_(uniqueTempPath("soak_" + tag + ".sock")) {
     auto ns = VethNamespace::create(VethOptions{kJumboMtu, true});
     if (!ns.ok()) {
       error_ = ns.error().message();
       return;
     }
     ns_.emplace(std::move(ns).value());
-    auto child = ns_->spawn({kEcsim, "serve", "--iface", ns_->simulatorInterface(), "--slaves", "4"},
+    auto child = ns_->spawn({kEcsim, "serve", "--iface", ns_->simulatorInterface(), "--slaves", "4",
+                             "--control", control_},
                             SpawnOptions{log_, log_});
     if (!child.ok()) {
       error_ = child.error().message();
       return;
     }
     server_ = std::move(child).value();
+  }
+  SoakedServer(const SoakedServer&) = delete;
+  SoakedServer& operator=(const SoakedServer&) = delete;
+  ~SoakedServer() {
+    if (server_.pid() > 0) (void)server_.stop();
+    std::filesystem::remove(control_);
   }
   const std::string& error() const { return error_; }
   const std::string& log() const { return log_; }
@@ -73,15 +84,21 @@ class SoakedServer {
 
  private:
   std::vector<std::string> soakArguments(const std::vector<std::string>& extra) const {
-    std::vector<std::string> argv{kSoak, "--iface", ns_->masterInterface(), "--server-pid",
-                                  std::to_string(server_.pid()), "--wait-ready-ms",
-                                  std::to_string(kStartUpMs), "--timeout-ms",
+    std::vector<std::string> argv{kSoak,
+                                  "--iface",
+                                  ns_->masterInterface(),
+                                  "--server-pid",
+                                  std::to_string(server_.pid()),
+                                  "--wait-ready-ms",
+                                  std::to_string(kStartUpMs),
+                                  "--timeout-ms",
                                   std::to_string(kSlowAnswerMs)};
     argv.insert(argv.end(), extra.begin(), extra.end());
     return argv;
   }
 
   std::string log_;
+  std::string control_;
   std::string error_;
   std::optional<VethNamespace> ns_;
   ChildProcess server_;
@@ -91,8 +108,8 @@ TEST(SoakVeth, HundredThousandFramesAllCheckedServerUnharmed) {
   ECSIM_REQUIRE_NETWORK();
   SoakedServer net("ci");
   ASSERT_TRUE(net.error().empty()) << net.error();
-  auto out = net.soak({"--frames", "100000", "--seed", "21", "--slaves", "4",
-                       "--malformed-percent", "20", "--window", "8"});
+  auto out = net.soak({"--frames", "100000", "--seed", "21", "--slaves", "4", "--malformed-percent",
+                       "20", "--window", "8"});
   ASSERT_TRUE(out.ok()) << out.error().message();
   const std::string& text = out->output;
   EXPECT_EQ(out->exitCode, 0) << text << readWholeFile(net.log());
@@ -104,9 +121,9 @@ TEST(SoakVeth, HundredThousandFramesAllCheckedServerUnharmed) {
   }
   // About a fifth malformed, every kind sent.
   EXPECT_GT(reported(text, "malformed sent"), 15000) << text;
-  for (const char* kind : {"  truncated", "  length past end", "  broken chain",
-                           "  EtherCAT type not 1", "  random bytes", "  other EtherType",
-                           "  oversized"}) {
+  for (const char* kind :
+       {"  truncated", "  length past end", "  broken chain", "  EtherCAT type not 1",
+        "  random bytes", "  other EtherType", "  oversized"}) {
     EXPECT_GT(reported(text, kind), 1000) << kind << "\n" << text;
   }
   ASSERT_TRUE(net.server().running()) << readWholeFile(net.log());
@@ -122,8 +139,8 @@ TEST(SoakVeth, HundredThousandFramesAllCheckedServerUnharmed) {
   ASSERT_NE(at, std::string::npos) << log;
   const long dropped = std::stol(log.substr(at + std::string("malformed dropped ").size()));
   EXPECT_EQ(dropped, reported(text, "  truncated") + reported(text, "  length past end") +
-                         reported(text, "  broken chain") + reported(text, "  EtherCAT type not 1") +
-                         reported(text, "  random bytes"))
+                         reported(text, "  broken chain") +
+                         reported(text, "  EtherCAT type not 1") + reported(text, "  random bytes"))
       << log << text;
   std::cout << text;  // the figures, for the CI log
   if (!HasFailure()) std::filesystem::remove(net.log());
