@@ -13,6 +13,7 @@
 #include "slavesim/coe/data_types.hpp"
 #include "slavesim/devices/device_models.hpp"
 #include "tests/slavesim/drive_test_support.hpp"
+#include "tests/slavesim/one_slave_topology.hpp"
 #include "topology/network_builder.hpp"
 
 namespace ecsim::testing {
@@ -39,7 +40,9 @@ TEST(DeviceModelChoice, ProfileAndObjectsChooseTheDriveForAnyVendor) {
 
 // Adds axis n's mandatory objects (controlword, statusword, modes, position actual value).
 void addAxis(slavesim::coe::ObjectDictionary& od, unsigned n) {
-  const auto at = [n](std::uint16_t index) { return static_cast<std::uint16_t>(index + n * 0x800); };
+  const auto at = [n](std::uint16_t index) {
+    return static_cast<std::uint16_t>(index + n * 0x800);
+  };
   od.addVar(at(c402::obj::kControlword), "Controlword", dt::kUnsigned16, 16, acc::kReadWrite);
   od.addVar(at(c402::obj::kStatusword), "Statusword", dt::kUnsigned16, 16, acc::kReadOnly);
   od.addVar(at(c402::obj::kModesOfOperation), "Mode", dt::kInteger8, 8, acc::kReadWrite);
@@ -71,30 +74,12 @@ TEST(DeviceModelChoice, EachAxisOfAMultiAxisDeviceGetsItsOwnDrive) {
   EXPECT_EQ(axes->axis(0).state(), c402::State::kSwitchOnDisabled);
 }
 
-class ModelAttribute : public ::testing::Test {
+class ModelAttribute : public OneSlaveTopology {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("ecsim-model-attr-" + std::to_string(::getpid()) + "-" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
   std::filesystem::path write(const std::string& attributes, const std::string& body = "",
                               std::uint32_t product = kEcs7201) {
-    const auto path = dir_ / "net.xml";
-    std::ofstream(path) << "<Topology name=\"t\">\n"
-                        << "  <Slave name=\"Axis\" esi=\"" << examplesEsiPath().string()
-                        << "\" product=\"" << product << "\" " << attributes << ">\n"
-                        << body << "  </Slave>\n</Topology>\n";
-    return path;
+    return writeTopology(attributes, body, product);
   }
-  Result<topology::Network> build(const std::filesystem::path& path) {
-    auto config = loadTopologyFile(path);
-    if (!config.ok()) return config.takeError();
-    return topology::buildNetwork(*config);
-  }
-  std::filesystem::path dir_;
 };
 
 TEST_F(ModelAttribute, AnUnknownModelIsAnErrorWithFileLineAndClosestName) {

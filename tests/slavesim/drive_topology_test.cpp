@@ -14,6 +14,7 @@
 #include "slavesim/devices/device_params.hpp"
 #include "slavesim/devices/io_terminals.hpp"
 #include "tests/slavesim/drive_test_support.hpp"
+#include "tests/slavesim/one_slave_topology.hpp"
 #include "topology/network_builder.hpp"
 
 namespace ecsim::testing {
@@ -21,35 +22,13 @@ namespace {
 
 constexpr double kTurn = 2.0 * std::numbers::pi;
 
-class DriveTopology : public ::testing::Test {
+class DriveTopology : public OneSlaveTopology {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("ecsim-drive-topology-" + std::to_string(::getpid()) + "-" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::remove_all(dir_);
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
-
-  // A topology file in the temporary folder with one slave of the examples ESI and `body`
-  // inside its <Slave> element.
+  // A topology with one slave of the examples ESI and `body` inside its <Slave> element.
   std::filesystem::path write(const std::string& attributes, const std::string& body,
                               std::uint32_t product = kEcs7211) {
-    const auto path = dir_ / "net.xml";
-    std::ofstream(path) << "<Topology name=\"t\">\n"
-                        << "  <Slave name=\"Axis\" esi=\"" << examplesEsiPath().string()
-                        << "\" product=\"" << product << "\" " << attributes << ">\n"
-                        << body << "  </Slave>\n</Topology>\n";
-    return path;
+    return writeTopology(attributes, body, product);
   }
-  Result<topology::Network> build(const std::filesystem::path& path) {
-    auto config = loadTopologyFile(path);
-    if (!config.ok()) return config.takeError();
-    return topology::buildNetwork(*config);
-  }
-
-  std::filesystem::path dir_;
 };
 
 TEST_F(DriveTopology, ParamsReachTheDriveModel) {
