@@ -122,6 +122,10 @@ TEST_F(ControlApiTest, ARegisterIsSetFromThePdiSide) {
   EXPECT_EQ(slave("DO1").esc().read(reg::kAlStatusCode), 0x001B);
   EXPECT_EQ(error(R"({"op":"set","slave":"DO1","register":"AlStatusCode","value":70000})"),
             "DO1 AL Status Code: value 70000 out of range 0..65535");
+  // AL Control is the master's (ECAT read/write, PDI read-only): the firmware cannot write it.
+  EXPECT_NE(error(R"({"op":"set","slave":"DO1","register":"AlControl","value":2})")
+                .find("DO1 AL Control is read-only from the PDI"),
+            std::string::npos);
   EXPECT_EQ(error(R"({"op":"set","slave":"DO1","register":"AlStatusCode"})"),
             "op 'set' needs \"value\"");
 }

@@ -142,6 +142,28 @@ std::optional<std::pair<std::uint16_t, std::uint8_t>> parseObject(std::string_vi
 }
 
 // Register names compared without case, spaces or a leading 'k' ("kAlStatus", "AL Status").
+// The registers the PDI may write, after the ESC datasheet section II register overview
+// (ET1100 column): AL Status and AL Status Code (ECAT read, PDI read/write), the RUN and ERR
+// LED overrides and the PDI's AL Event Mask (PDI read/write). Every other named register is
+// read-only from the PDI (AL Control, DL Control, the SM and FMMU channels' ECAT parts, DC...), so
+// the socket refuses to write it: the slave's firmware could not either.
+constexpr std::array kPdiWritable{
+    reg::RegisterInfo{reg::kAlStatus.address, reg::kAlStatus.width, reg::kAlStatus.name},
+    reg::RegisterInfo{reg::kAlStatusCode.address, reg::kAlStatusCode.width,
+                      reg::kAlStatusCode.name},
+    reg::RegisterInfo{reg::kRunLedOverride.address, reg::kRunLedOverride.width,
+                      reg::kRunLedOverride.name},
+    reg::RegisterInfo{reg::kErrLedOverride.address, reg::kErrLedOverride.width,
+                      reg::kErrLedOverride.name},
+    reg::RegisterInfo{reg::kPdiAlEventMask.address, reg::kPdiAlEventMask.width,
+                      reg::kPdiAlEventMask.name},
+};
+
+bool pdiWritable(const reg::RegisterInfo& r) {
+  return std::any_of(kPdiWritable.begin(), kPdiWritable.end(),
+                     [&](const reg::RegisterInfo& w) { return w.address == r.address; });
+}
+
 std::string registerKey(std::string_view name) {
   if (name.size() > 1 && name[0] == 'k' && std::isupper(static_cast<unsigned char>(name[1]))) {
     name.remove_prefix(1);
@@ -302,6 +324,15 @@ std::string ControlApi::answerJson(std::string_view line, ClientId client, SimTi
         // Written from the PDI side, as the slave's own firmware writes its ESC (AL status,
         // AL status code, PDI-owned registers): what the master then reads.
         const std::string what = text("slave") + " " + std::string(r->name);
+        if (!pdiWritable(*r)) {
+          std::string names;
+          for (const auto& w : kPdiWritable)
+            names += (names.empty() ? "" : ", ") + std::string(w.name);
+          return failure(what +
+                         " is read-only from the PDI (ESC datasheet section II); the PDI "
+                         "writes: " +
+                         names);
+        }
         if (r->width > 8) return failure(what + " is longer than 8 bytes: not settable here");
         auto raw = encodeValue(request["value"], 0, static_cast<std::uint16_t>(8 * r->width), what);
         if (!raw.ok()) return failure(raw.error().context);
