@@ -57,8 +57,22 @@ void Esc::reset() {
   writeLe16(memory_, reg::kEscFeatures.address, type_.features);
   latchReset();       // DC latch unit (esc_latch.cpp), before the event state follows it
   resetEventState();  // AL control mailbox, ECAT event state (esc_events.cpp)
-  miiReset();  // esc_mii.cpp
-  loadFromSii();  // also takes the addressing copies (refreshAddressing)
+  miiReset();         // esc_mii.cpp
+  loadFromSii();      // also takes the addressing copies (refreshAddressing)
+}
+
+void Esc::setObserver(EscObserver* observer, std::uint32_t id) {
+  observer_ = observer;
+  observerId_ = id;
+  eventsNoted_ = false;
+  irqNoted_ = 0;
+  smNoted_ = false;
+  if (observer_ == nullptr) return;
+  if (hasEvents()) noteEvent();
+  observer_->escIrqChanged(observerId_, ecatIrq_, smEventMask_ != 0);
+  irqNoted_ = ecatIrq_;
+  smNoted_ = smEventMask_ != 0;
+  observer_->escAddressingChanged(observerId_);
 }
 
 void Esc::powerOnReset() {
@@ -74,7 +88,7 @@ SimTime Esc::systemTime(SimTime time) const {
 void Esc::processDatagram(DatagramView d, SimTime time) {
   lastWkcIncrement_ = 0;
   now_ = time;
-  orEventsIntoIrq(d);  // the header passes first (esc_events.cpp)
+  orEventsIntoIrq(d);                           // the header passes first (esc_events.cpp)
   if (!isKnownCommand(d.rawCommand())) return;  // unknown command: forwarded untouched
   const Command cmd = d.command();
   const std::uint16_t len = d.length();

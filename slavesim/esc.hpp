@@ -26,7 +26,9 @@
 namespace ecsim::slavesim {
 
 struct EscCounters {
-  std::uint64_t framesSeen{0};  // first: Esc keeps it on a cache line every frame touches
+  // framesSeen: first, on a cache line every frame touches. A network letting frames pass
+  // without a visit adds them later (topology::Segment::framesSeen counts them all).
+  std::uint64_t framesSeen{0};
   std::uint64_t datagramsAddressed{0};
   std::uint64_t mailboxWrites{0};
   std::uint64_t mailboxWritesRejected{0};
@@ -46,6 +48,25 @@ struct EscEvents {
   bool dlControlWritten{false};  // port loop settings may have changed
 };
 
+// Told by an ESC when something changes that a network keeps an index of, so that a frame
+// passes and the firmware runs only where there is something to do (topology::Segment). Each
+// call carries the id the ESC was given with setObserver().
+class EscObserver {
+ public:
+  // The ESC holds events for its firmware again (none were pending since the last
+  // takeEvents()).
+  virtual void escEventsRaised(std::uint32_t id) = 0;
+  // Its station address, alias or alias enable changed (refreshAddressing()).
+  virtual void escAddressingChanged(std::uint32_t id) = 0;
+  // What it ORs into the IRQ field of a datagram header passing it changed: `irq` now (kept
+  // current between frames), or, with `followsSm`, whatever its SyncManagers' status gives
+  // when the header passes (headerIrq() asks them; SM events in the ECAT event mask).
+  virtual void escIrqChanged(std::uint32_t id, std::uint16_t irq, bool followsSm) = 0;
+
+ protected:
+  ~EscObserver() = default;
+};
+
 class Esc {
  public:
   Esc(const EscType& type, std::vector<std::uint8_t> siiImage);
@@ -63,6 +84,9 @@ class Esc {
     if (smEventMask_ != 0) refreshEcatEvents();
     return ecatIrq_;
   }
+  // The observer told of events, addressing and IRQ changes (nullptr: none). It is told at
+  // once of what holds now.
+  void setObserver(EscObserver* observer, std::uint32_t id);
   // A configured-address datagram (FPRD/FPWR/FPRW) with this ADP is addressed to this ESC: its
   // station address, or its alias while DL control enables it (0x0103 bit 0). Anything else
   // such a datagram meets here is only its header passing (headerIrq()).
@@ -85,6 +109,11 @@ class Esc {
   // are discarded, and the frame counts in 0x030C.
   void beginFrame(bool invalid = false) {
     ++counters_.framesSeen;
+    beginFrameUncounted(invalid);
+  }
+  // As beginFrame, but the frame is counted in framesSeen by addFramesSeen() later (a
+  // network that lets frames pass ESCs they do not concern without visiting them).
+  void beginFrameUncounted(bool invalid = false) {
     smEndAccessed_ = 0;
     invalidFrame_ = invalid;
     if (invalid) countProcessingUnitError();
@@ -168,8 +197,10 @@ class Esc {
   EscEvents takeEvents() {
     EscEvents e = events_;
     events_ = {};
+    eventsNoted_ = false;
     return e;
   }
+  void addFramesSeen(std::uint64_t n) { counters_.framesSeen += n; }
 
   // Typed register access through the register map (protocol/registers.hpp): the width comes
   // from the register, never from the caller. Little-endian as on the wire.
@@ -304,21 +335,45 @@ class Esc {
   std::uint16_t alias_{0};
   bool aliasOn_{false};
   void refreshAddressing() {
-    station_ = reg16(reg::kConfiguredStationAddress.address);
-    alias_ = reg16(reg::kConfiguredStationAlias.address);
-    aliasOn_ = (memory_[reg::kDlControl.address + 3] & 0x01) != 0;
+    const std::uint16_t station = reg16(reg::kConfiguredStationAddress.address);
+    const std::uint16_t alias = reg16(reg::kConfiguredStationAlias.address);
+    const bool aliasOn = (memory_[reg::kDlControl.address + 3] & 0x01) != 0;
+    if (station == station_ && alias == alias_ && aliasOn == aliasOn_) return;
+    station_ = station;
+    alias_ = alias;
+    aliasOn_ = aliasOn;
+    if (observer_ != nullptr) observer_->escAddressingChanged(observerId_);
   }
+  // Marks an event for the firmware: events_.x = true, then noteEvent().
+  void noteEvent() {
+    if (eventsNoted_ || observer_ == nullptr) return;
+    eventsNoted_ = true;
+    observer_->escEventsRaised(observerId_);
+  }
+  void noteIrq() {
+    if (observer_ == nullptr) return;
+    const bool followsSm = smEventMask_ != 0;
+    if (ecatIrq_ == irqNoted_ && followsSm == smNoted_) return;
+    irqNoted_ = ecatIrq_;
+    smNoted_ = followsSm;
+    observer_->escIrqChanged(observerId_, ecatIrq_, followsSm);
+  }
+  EscObserver* observer_{nullptr};
+  std::uint32_t observerId_{0};
+  bool eventsNoted_{false};
+  std::uint16_t irqNoted_{0};
+  bool smNoted_{false};
   // Per-frame state of the SM rules and invalid frames (esc_sm.cpp).
   bool invalidFrame_{false};
   bool latchArmed_{false};
-  SimTime now_{0};       // simulation time of the datagram being processed
-  SimTime localNow_{0};  // local time of the datagram being processed
+  SimTime now_{0};                  // simulation time of the datagram being processed
+  SimTime localNow_{0};             // local time of the datagram being processed
   std::uint32_t smEndAccessed_{0};  // bit per SM: its end address was accessed in this frame
   std::uint8_t activeFmmuCount_{0};
   std::uint8_t smRangeCount_{0};
   std::uint8_t smTriggerOnlyCount_{0};
   DcUnit dcUnit_{DcUnit::kFull};
-  EscCounters counters_{};  // framesSeen first: on line 1
+  EscCounters counters_{};                        // framesSeen first: on line 1
   alignas(64) std::vector<std::uint8_t> memory_;  // registers 0x0000-0x0FFF + process RAM
   const RegisterBytes& regs_;  // the register table, per byte (shared by all ESCs)
   struct ActiveFmmu {
@@ -401,8 +456,7 @@ class Esc {
                address == reg::kDcActivation.address) {
       onSyncActivationWrite();
       latchEventsChanged();  // 0x0980 says who owns the latch units
-    } else if (address == reg::kLatch0Control.address ||
-               address == reg::kLatch1Control.address) {
+    } else if (address == reg::kLatch0Control.address || address == reg::kLatch1Control.address) {
       latchControlWritten();
     }
   }
@@ -527,7 +581,7 @@ class Esc {
   void pdiSmStatusChanged() {
     if (smEventMask_ != 0) refreshEcatEvents();
   }
-  bool alControlUnread_{false};   // written by ECAT, not yet read by the PDI
+  bool alControlUnread_{false};  // written by ECAT, not yet read by the PDI
 
   // ---- SyncManager access rules and invalid frames (esc_sm.cpp; section I §8, §14.1) ----
   enum class SmAccess : std::uint8_t {

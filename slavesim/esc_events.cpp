@@ -38,6 +38,7 @@ std::uint16_t Esc::pdiReadAlControl() {
 
 void Esc::ecatAlControlWritten() {
   events_.alControlWritten = true;
+  noteEvent();
   pdiWrite(reg::kAlEventRequest, read(reg::kAlEventRequest) | reg::al_event::kAlControl);
   if (!deviceEmulation()) {
     alControlUnread_ = true;
@@ -82,6 +83,7 @@ void Esc::refreshEcatEvents() {
   }
   pdiWrite(reg::kEcatEventRequest, request);
   ecatIrq_ = static_cast<std::uint16_t>(request & read(reg::kEcatEventMask));
+  noteIrq();
 }
 
 void Esc::ecatEventMaskWritten() {

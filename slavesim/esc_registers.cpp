@@ -148,6 +148,7 @@ void Esc::runWriteHook(WriteHook hook, std::uint32_t begin, std::uint32_t end, C
       break;
     case WriteHook::kDlControl:
       events_.dlControlWritten = true;
+      noteEvent();
       break;
     case WriteHook::kAlControl:
       ecatAlControlWritten();  // esc_events.cpp
@@ -188,10 +189,12 @@ void Esc::runWriteHook(WriteHook hook, std::uint32_t begin, std::uint32_t end, C
             (memory_[base + reg::sm::kActivate.address] & reg::sm::kActivateRepeatRequest) !=
                 (memory_[base + reg::sm::kPdiControl.address] & reg::sm::kPdiRepeatAck)) {
           events_.mailboxRead = true;  // firmware sees the repeat request toggle
+          noteEvent();
         }
       }
       rebuildSmCache();
       events_.smConfigChanged = true;
+      noteEvent();
       break;
   }
 }
@@ -284,6 +287,7 @@ void Esc::completeReceiveTimeLatch(const std::array<SimTime, 4>& times, std::uin
 void Esc::latchReceiveTimes() {
   latchArmed_ = true;  // 0x0900-0x090F and 0x0918 are written once the frame has passed
   events_.dcLatched = true;
+  noteEvent();
 }
 
 }  // namespace ecsim::slavesim

@@ -139,6 +139,7 @@ void Esc::siiExecute(std::uint16_t command, std::uint32_t word, std::uint16_t da
       loadFromSii();
       status = reg16(reg::kSiiControlStatus.address);
       events_.eepromReloaded = true;
+      noteEvent();
       break;
     default:
       break;

@@ -142,6 +142,7 @@ bool Esc::readRam(std::uint16_t address, Bytes out, bool orInto, int smIndex) {
       status = static_cast<std::uint8_t>((status & ~reg::sm::kStatusMailboxFull) |
                                          reg::sm::kStatusInterruptRead);
       events_.mailboxRead = true;
+      noteEvent();
     }
     return true;
   }
@@ -195,6 +196,7 @@ bool Esc::writeRam(std::uint16_t address, ConstBytes data, int smIndex) {
       status |= reg::sm::kStatusMailboxFull | reg::sm::kStatusInterruptWrite;
       ++counters_.mailboxWrites;
       events_.mailboxReceived = true;
+      noteEvent();
     }
     return true;
   }
@@ -226,6 +228,7 @@ bool Esc::writeRam(std::uint16_t address, ConstBytes data, int smIndex) {
         (memory_[base + reg::sm::kStatus.address] & ~reg::sm::kStatusBufferMask) | (done << 4) |
         reg::sm::kStatusInterruptWrite);
     events_.outputsWritten = true;
+    noteEvent();
   }
   return true;
 }

@@ -44,6 +44,17 @@ class Device {
   virtual Status coldStart() { return okStatus(); }
 };
 
+// The network that runs the slaves' firmware (topology::Segment): told of ESC events (and of
+// addressing and IRQ changes, EscObserver) and when a slave gains or loses a device or a
+// mailbox server, so that it polls only the slaves with something to do.
+class FirmwarePoller : public EscObserver {
+ public:
+  virtual void firmwareChanged(std::uint32_t id) = 0;
+
+ protected:
+  ~FirmwarePoller() = default;
+};
+
 class Slave {
  public:
   Slave(std::string name, const EscType& type, std::vector<std::uint8_t> sii, SlaveProfile profile);
@@ -54,11 +65,29 @@ class Slave {
   SlaveProfile& profile() { return profile_; }
   AlState state() const { return AlStateMachine::state(esc_); }
 
-  void setMailboxServer(std::unique_ptr<MailboxServer> server) { mailbox_ = std::move(server); }
-  void setDevice(std::unique_ptr<Device> device) { device_ = std::move(device); }
+  void setMailboxServer(std::unique_ptr<MailboxServer> server) {
+    mailbox_ = std::move(server);
+    firmwareChanged();
+  }
+  void setDevice(std::unique_ptr<Device> device) {
+    device_ = std::move(device);
+    firmwareChanged();
+  }
   MailboxServer* mailboxServer() { return mailbox_.get(); }
   // Hands the mailbox server over (to wrap it, e.g. for fault injection).
-  std::unique_ptr<MailboxServer> takeMailboxServer() { return std::move(mailbox_); }
+  std::unique_ptr<MailboxServer> takeMailboxServer() {
+    firmwareChanged();
+    return std::move(mailbox_);
+  }
+  // Whether poll() has work even without ESC events: a device or a mailbox server.
+  bool hasFirmware() const { return device_ != nullptr || mailbox_ != nullptr; }
+  // The network polling this slave (nullptr: none); `id` is its index there. The ESC's
+  // observer is the poller too.
+  void setPoller(FirmwarePoller* poller, std::uint32_t id) {
+    poller_ = poller;
+    pollerId_ = id;
+    esc_.setObserver(poller, id);
+  }
   Device* device() { return device_.get(); }
 
   // Runs the firmware: reacts to ESC events (AL control, mailbox) and steps the device.
@@ -105,6 +134,11 @@ class Slave {
   bool firmwareRunning_{true};
   bool started_{false};  // Device::powerUp called
   Status coldStartStatus_;
+  FirmwarePoller* poller_{nullptr};
+  std::uint32_t pollerId_{0};
+  void firmwareChanged() {
+    if (poller_ != nullptr) poller_->firmwareChanged(pollerId_);
+  }
 };
 
 }  // namespace ecsim::slavesim
