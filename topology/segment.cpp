@@ -35,6 +35,7 @@ std::size_t Segment::addSlave(std::unique_ptr<slavesim::Slave> slave) {
   routeArrival_.push_back({});
   routeValid_ = false;
   latched_.reserve(slaves_.size());
+  indexNewSlave(slaves_.size() - 1);
   refreshLinkStatus(slaves_.size() - 1);  // only its own status: it has no links yet
   return slaves_.size() - 1;
 }
@@ -246,7 +247,10 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
   // A walk with faults keeps the recorded route: clearing it while routeValid_ stays set made
   // the next fault-free frame reach no ESC at all (WKC 0).
   const bool record = faults_ == nullptr;
-  if (record) route_.clear();
+  if (record) {
+    routeChanging();
+    route_.clear();
+  }
   stack_.clear();
   for (auto& m : arrivalMask_) m = 0;
   std::uint32_t s = 0;
@@ -332,6 +336,7 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
     routeMask_ = arrivalMask_;
     routeRoundTrip_ = outcome.firstBitRoundTrip;
     routeValid_ = true;
+    routeRecorded();
   }
   // The master has the frame when its last bit is in: wire footprint of the frame itself
   // (preamble + SFD + frame + FCS).
@@ -352,23 +357,6 @@ bool Segment::arriveWithFaults(std::size_t s, unsigned port, SimTime& t, bool& b
     bad = true;
   }
   return !bad;
-}
-
-void Segment::pollSlaves(SimTime now) {
-  if (now >= nextLoopRevert_) revertTemporaryLoops(now);
-  bool dlChanged = false;
-  for (std::size_t i = 0; i < slaves_.size(); ++i) {
-    auto& slave = *slaves_[i];
-    if (slave.esc().hasEvents() && slave.esc().peekEvents().dlControlWritten) {
-      dlChanged = true;
-      noteDlControlWrite(i, now);
-    }
-    if (slave.esc().hasEvents() || slave.device() != nullptr ||
-        slave.mailboxServer() != nullptr) {
-      slave.poll(now);
-    }
-  }
-  if (dlChanged) refreshLinkStatus();
 }
 
 }  // namespace ecsim::topology

@@ -73,11 +73,20 @@ struct SegmentCounters {
   std::uint64_t framesProcessed{0};
   std::uint64_t framesMalformed{0};
   std::uint64_t datagramsProcessed{0};
+  std::uint64_t framesAddressedPass{0};  // passed visiting only the ESCs concerned
 };
 
-class Segment {
+// The slaves and their wiring. A frame passes the ESCs it concerns: with the route recorded
+// and no faults, a frame of configured-address and auto-increment datagrams visits only the
+// ESCs they address (and those following SM events for the IRQ field), found through an index of
+// station addresses and route positions (segment_index.cpp); the firmware runs for the slaves with
+// a device or mailbox server and those whose ESC raised events (pollSlaves). Both keep the cost of
+// a frame independent of the number of slaves it passes, so bring-up is linear in the network size
+// (issue #18).
+class Segment : private slavesim::FirmwarePoller {
  public:
   Segment() = default;
+  ~Segment();
   Segment(const Segment&) = delete;
   Segment& operator=(const Segment&) = delete;
 
@@ -124,6 +133,12 @@ class Segment {
   void setWireFaults(WireFaults* faults) { faults_ = faults; }
 
   const SegmentCounters& counters() const { return counters_; }
+  // Frames slave i's ESC has seen (EscCounters::framesSeen plus the frames that passed it on
+  // the recorded route without a visit).
+  std::uint64_t framesSeen(std::size_t i) const;
+  // Off: every frame visits every ESC on its way, as before the index (for tests comparing
+  // the two; the results are the same).
+  void setIndexedPasses(bool on) { indexedPasses_ = on; }
   const TimingModel& timing() const { return timing_; }
   void setTiming(const TimingModel& t) {
     timing_ = t;
@@ -196,13 +211,76 @@ class Segment {
   // its IRQ field: the same frame and ESC state as processing every datagram at every ESC,
   // without a cost per datagram and ESC.
   void passRoute(std::size_t count, const std::array<SimTime, 128>& leads, SimTime sendTime);
-  void passRouteIndexed(std::size_t count, const std::array<SimTime, 128>& leads,
-                        SimTime sendTime);
+  void passRouteIndexed(std::size_t count, const std::array<SimTime, 128>& leads, SimTime sendTime);
   // Scratch of passRouteIndexed, per frame: datagrams every ESC processes, configured-address
   // datagrams by (ADP, index), and per IRQ bit the ESCs asking for it from datagram k on.
   std::array<std::uint8_t, 128> everywhere_{};
   std::array<std::uint32_t, 128> byAddress_{};
   std::array<std::array<std::int32_t, 129>, 16> irqRuns_{};
+  // The IRQ bits the ESCs asked for (irqRuns_) go into the datagrams' IRQ fields.
+  void applyIrqRuns(std::size_t count);
+
+  // ---- the index of the passes that visit only the ESCs concerned (segment_index.cpp) ----
+  // A frame of configured-address (FPRD/FPWR/FPRW), auto-increment (APRD/APWR/APRW) and
+  // header-only datagrams along the recorded route, visiting the ESCs addressed and those
+  // following SM events; the IRQ bits of the others go into every header. false (nothing done) when
+  // a configured address belongs to several ESCs: the caller takes the indexed pass then.
+  bool passRouteAddressed(std::size_t count, const std::array<SimTime, 128>& leads,
+                          SimTime sendTime);
+  // One ESC of that pass at route position `pos`: the datagrams addressed to it, judged with
+  // its addressing as it is when each comes (a write may change it).
+  void visitAddressed(std::size_t pos, std::size_t count, const std::array<SimTime, 128>& leads,
+                      SimTime sendTime);
+  // FirmwarePoller: what the slaves tell the segment.
+  void escEventsRaised(std::uint32_t id) override;
+  void escAddressingChanged(std::uint32_t id) override;
+  void escIrqChanged(std::uint32_t id, std::uint16_t irq, bool followsSm) override;
+  void firmwareChanged(std::uint32_t /*id*/) override { firmwareDirty_ = true; }
+  void indexNewSlave(std::size_t i);  // from addSlave
+  // The recorded route changes: the frames it owes its ESCs are counted in, positions renewed.
+  void routeChanging();
+  void routeRecorded();
+  // Brings the address tables up to date (the addressing changes queued since).
+  void updateAddressTables();
+  void tableAdd(std::uint32_t slave);
+  void tableRemove(std::uint32_t slave);
+  // Route position + 1 of the single ESC answering `address` (0: none or unknown).
+  std::uint32_t ownerOf(std::uint16_t address);
+  static constexpr std::uint32_t kOffRoute = 0xFFFFFFFF;
+  bool indexedPasses_{true};
+  std::vector<std::uint32_t> routePos_;  // per slave: its position in route_, or kOffRoute
+  std::uint64_t framesOwed_{0};          // frames that passed route_ by passRouteAddressed
+  // Per configured address (65536 entries, made with the first route): how many ESCs on the
+  // route answer it, and the route position + 1 of the one that does (0: none or not known).
+  std::vector<std::uint32_t> addrCount_;
+  std::vector<std::uint32_t> addrOwner_;
+  struct Answering {
+    std::uint16_t station{0};
+    std::uint16_t alias{0};
+    bool aliasOn{false};
+    bool listed{false};  // counted in the tables
+  };
+  std::vector<Answering> answering_;  // per slave: what the tables hold for it
+  bool tablesValid_{false};
+  std::vector<std::uint32_t> addressingQueue_;  // slaves whose addressing changed since
+  std::vector<std::uint8_t> addressingQueued_;
+  std::uint64_t addressingEpoch_{0};  // counts addressing changes (a pass notices one)
+  // IRQ bits: the ESCs following their SyncManagers (visited by every pass), what each of the
+  // others ORs into a passing header, and per bit how many ESCs on the route set it.
+  std::vector<std::uint32_t> irqSet_;   // slaves following their SMs
+  std::vector<std::uint32_t> irqSlot_;  // per slave: index + 1 in irqSet_, 0: not in it
+  std::vector<std::uint16_t> irqKnown_;
+  std::array<std::uint32_t, 16> irqCount_{};
+  void countIrq(std::uint16_t irq, int delta);
+  std::vector<std::uint32_t> visits_;         // scratch: route position << 8 | datagram
+  std::array<std::uint16_t, 128> adpSent_{};  // scratch: ADP of auto-increment datagrams
+  // Firmware polls: the slaves with a device or mailbox server (every poll) and those whose
+  // ESC raised events since the last poll.
+  std::vector<std::uint32_t> firmwareSlaves_;
+  bool firmwareDirty_{true};
+  std::vector<std::uint32_t> eventful_;
+  std::vector<std::uint32_t> polling_;
+  std::vector<std::uint8_t> eventQueued_;
   std::vector<std::array<SimTime, kPortCount>> routeArrival_;
   std::vector<std::uint8_t> routeMask_;
   SimTime routeRoundTrip_{0};

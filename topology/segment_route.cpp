@@ -7,10 +7,11 @@
 namespace ecsim::topology {
 namespace {
 
-// FPRD/FPWR/FPRW: one ESC (its station address or enabled alias) acts on it. FRMW writes at
-// every ESC but the addressed one, so it goes everywhere like auto-increment, broadcast and
-// logical datagrams; NOP and unknown commands only collect the IRQ field.
-enum class Reach { kEverywhere, kAddressed, kHeaderOnly };
+// FPRD/FPWR/FPRW: one ESC (its station address or enabled alias) acts on it. APRD/APWR/APRW:
+// the ESC at the route position the ADP counts to (every ESC increments it, the one seeing 0
+// acts). FRMW and ARMW write at every ESC but the addressed one, so they go everywhere like
+// broadcast and logical datagrams; NOP and unknown commands only collect the IRQ field.
+enum class Reach { kEverywhere, kAddressed, kPosition, kHeaderOnly };
 
 Reach reach(const DatagramView& d) {
   if (!isKnownCommand(d.rawCommand())) return Reach::kHeaderOnly;
@@ -20,9 +21,16 @@ Reach reach(const DatagramView& d) {
       return Reach::kHeaderOnly;
     case AddressMode::kConfigured:
       return cmd == Command::kFrmw ? Reach::kEverywhere : Reach::kAddressed;
+    case AddressMode::kAutoIncrement:
+      return cmd == Command::kArmw ? Reach::kEverywhere : Reach::kPosition;
     default:
       return Reach::kEverywhere;
   }
+}
+
+// The route position an auto-increment datagram sent with `adp` acts at.
+std::uint32_t positionOf(std::uint16_t adp) {
+  return static_cast<std::uint16_t>(0x10000u - adp);
 }
 
 }  // namespace
@@ -30,9 +38,13 @@ Reach reach(const DatagramView& d) {
 void Segment::passRoute(std::size_t count, const std::array<SimTime, 128>& leads,
                         SimTime sendTime) {
   bool addressedOnly = false;
-  for (std::size_t i = 0; i < count && !addressedOnly; ++i) {
-    addressedOnly = reach(datagrams_[i]) == Reach::kAddressed;
+  bool everywhere = false;
+  for (std::size_t i = 0; i < count; ++i) {
+    const Reach r = reach(datagrams_[i]);
+    addressedOnly = addressedOnly || r == Reach::kAddressed;
+    everywhere = everywhere || r == Reach::kEverywhere;
   }
+  if (indexedPasses_ && !everywhere && passRouteAddressed(count, leads, sendTime)) return;
   if (addressedOnly) {
     passRouteIndexed(count, leads, sendTime);
     return;
@@ -53,9 +65,12 @@ void Segment::passRouteIndexed(std::size_t count, const std::array<SimTime, 128>
   std::size_t nAddressed = 0;
   for (std::size_t i = 0; i < count; ++i) {
     const Reach r = reach(datagrams_[i]);
-    if (r == Reach::kEverywhere) everywhere_[nEverywhere++] = static_cast<std::uint8_t>(i);
+    if (r == Reach::kEverywhere || r == Reach::kPosition) {
+      everywhere_[nEverywhere++] = static_cast<std::uint8_t>(i);  // every ESC counts the ADP
+    }
     if (r == Reach::kAddressed) {
-      byAddress_[nAddressed++] = static_cast<std::uint32_t>(datagrams_[i].adp()) << 8 | static_cast<std::uint32_t>(i);
+      byAddress_[nAddressed++] =
+          static_cast<std::uint32_t>(datagrams_[i].adp()) << 8 | static_cast<std::uint32_t>(i);
     }
   }
   std::sort(byAddress_.begin(), byAddress_.begin() + static_cast<std::ptrdiff_t>(nAddressed));
@@ -68,7 +83,8 @@ void Segment::passRouteIndexed(std::size_t count, const std::array<SimTime, 128>
     const auto* e = std::lower_bound(b, addrEnd, key + 0x100);
     return std::pair{b, e};
   };
-  for (auto& bit : irqRuns_) std::fill(bit.begin(), bit.begin() + static_cast<std::ptrdiff_t>(count) + 1, 0);
+  for (auto& bit : irqRuns_)
+    std::fill(bit.begin(), bit.begin() + static_cast<std::ptrdiff_t>(count) + 1, 0);
   // This ESC's event request `irq` goes into the IRQ field of datagrams [from, to).
   auto addIrq = [&](std::uint16_t irq, std::size_t from, std::size_t to) {
     if (irq == 0 || from >= to) return;
@@ -98,9 +114,9 @@ void Segment::passRouteIndexed(std::size_t count, const std::array<SimTime, 128>
     std::size_t from = 0;  // datagrams before this have this ESC's IRQ accounted for
     std::uint16_t irq = esc.headerIrq();
     for (;;) {
-      const std::size_t next = std::min({e < nEverywhere ? everywhere_[e] : kNone,
-                                         s != sEnd ? (*s & 0xFF) : kNone,
-                                         a != aEnd ? (*a & 0xFF) : kNone});
+      const std::size_t next =
+          std::min({e < nEverywhere ? everywhere_[e] : kNone, s != sEnd ? (*s & 0xFF) : kNone,
+                    a != aEnd ? (*a & 0xFF) : kNone});
       if (next == kNone) break;
       addIrq(irq, from, next);
       esc.processDatagram(datagrams_[next], t + leads[next]);
@@ -124,13 +140,136 @@ void Segment::passRouteIndexed(std::size_t count, const std::array<SimTime, 128>
     addIrq(irq, from, count);
     if (esc.receiveTimeLatchArmed()) latched_.push_back(stop.slave);
   }
+  applyIrqRuns(count);
+}
+
+void Segment::applyIrqRuns(std::size_t count) {
   for (std::size_t b = 0; b < irqRuns_.size(); ++b) {
     std::int32_t asking = 0;
     for (std::size_t i = 0; i < count; ++i) {
       asking += irqRuns_[b][i];
-      if (asking > 0) datagrams_[i].setIrq(static_cast<std::uint16_t>(datagrams_[i].irq() | (1u << b)));
+      if (asking > 0)
+        datagrams_[i].setIrq(static_cast<std::uint16_t>(datagrams_[i].irq() | (1u << b)));
     }
   }
+}
+
+bool Segment::passRouteAddressed(std::size_t count, const std::array<SimTime, 128>& leads,
+                                 SimTime sendTime) {
+  updateAddressTables();
+  const auto stops = static_cast<std::uint32_t>(route_.size());
+  visits_.clear();
+  bool configured = false;
+  for (std::size_t i = 0; i < count; ++i) {
+    const DatagramView& d = datagrams_[i];
+    const Reach r = reach(d);
+    std::uint32_t pos = kOffRoute;
+    if (r == Reach::kPosition) {
+      adpSent_[i] = d.adp();
+      pos = positionOf(d.adp());
+    } else if (r == Reach::kAddressed) {
+      configured = true;
+      if (addrCount_[d.adp()] > 1) return false;  // several ESCs answer it: the indexed pass
+      const std::uint32_t owner = ownerOf(d.adp());
+      if (owner != 0) pos = owner - 1;
+    }
+    if (pos < stops) visits_.push_back(pos << 8 | static_cast<std::uint32_t>(i));
+  }
+  constexpr std::uint32_t kHeaderOnlyVisit = 0xFF;  // sorts after the datagrams of a position
+  for (const std::uint32_t slave : irqSet_) {
+    if (routePos_[slave] != kOffRoute) visits_.push_back(routePos_[slave] << 8 | kHeaderOnlyVisit);
+  }
+  std::sort(visits_.begin(), visits_.end());
+  for (auto& bit : irqRuns_)
+    std::fill(bit.begin(), bit.begin() + static_cast<std::ptrdiff_t>(count) + 1, 0);
+  const std::uint64_t epoch = addressingEpoch_;
+  std::uint32_t last = kOffRoute;
+  std::uint32_t rest = stops;  // from here on every ESC is visited (see below)
+  for (const std::uint32_t v : visits_) {
+    const std::uint32_t pos = v >> 8;
+    if (pos == last) continue;
+    last = pos;
+    visitAddressed(pos, count, leads, sendTime);
+    // A write changed an ESC's addressing: which ESC a later configured-address datagram of
+    // this frame concerns is no longer what the tables say, so the rest of the route is
+    // visited ESC by ESC (as the indexed pass does).
+    if (configured && addressingEpoch_ != epoch) {
+      rest = pos + 1;
+      break;
+    }
+  }
+  for (std::uint32_t pos = rest; pos < stops; ++pos) visitAddressed(pos, count, leads, sendTime);
+  // The ESCs not visited OR what they ask for into every header: the bits set by ESCs on the
+  // route, less those of the ESCs visited (theirs went in as each header passed them).
+  std::array<std::uint32_t, 16> others = irqCount_;
+  auto uncount = [&](std::uint32_t pos) {
+    for (unsigned bits = irqKnown_[route_[pos].slave]; bits != 0; bits &= bits - 1) {
+      --others[static_cast<std::size_t>(std::countr_zero(bits))];
+    }
+  };
+  last = kOffRoute;
+  for (const std::uint32_t v : visits_) {
+    const std::uint32_t pos = v >> 8;
+    if (pos >= rest) break;
+    if (pos != last) uncount(pos);
+    last = pos;
+  }
+  for (std::uint32_t pos = rest; pos < stops; ++pos) uncount(pos);
+  std::uint16_t passing = 0;
+  for (std::size_t b = 0; b < others.size(); ++b) {
+    if (others[b] != 0) passing = static_cast<std::uint16_t>(passing | (1u << b));
+  }
+  for (std::size_t i = 0; i < count; ++i) {  // every ESC on the route counted the ADP on
+    if (reach(datagrams_[i]) == Reach::kPosition) {
+      datagrams_[i].setAdp(static_cast<std::uint16_t>(adpSent_[i] + stops));
+    }
+  }
+  applyIrqRuns(count);
+  if (passing != 0) {
+    for (std::size_t i = 0; i < count; ++i) {
+      datagrams_[i].setIrq(static_cast<std::uint16_t>(datagrams_[i].irq() | passing));
+    }
+  }
+  ++framesOwed_;
+  ++counters_.framesAddressedPass;
+  return true;
+}
+
+void Segment::visitAddressed(std::size_t pos, std::size_t count,
+                             const std::array<SimTime, 128>& leads, SimTime sendTime) {
+  const RouteStop& stop = route_[pos];
+  slavesim::Esc& esc = *escs_[stop.slave];
+  esc.beginFrameUncounted();
+  const SimTime t = sendTime + stop.at;
+  std::size_t from = 0;  // datagrams before this have this ESC's IRQ accounted for
+  std::uint16_t irq = esc.headerIrq();
+  auto addIrq = [&](std::size_t to) {
+    if (irq == 0 || from >= to) return;
+    for (unsigned bits = irq; bits != 0; bits &= bits - 1) {
+      const auto b = static_cast<unsigned>(std::countr_zero(bits));
+      ++irqRuns_[b][from];
+      --irqRuns_[b][to];
+    }
+  };
+  for (std::size_t i = 0; i < count; ++i) {
+    DatagramView& d = datagrams_[i];
+    const Reach r = reach(d);
+    bool mine = false;
+    if (r == Reach::kPosition) {
+      mine = positionOf(adpSent_[i]) == pos;
+      if (mine) d.setAdp(0);  // the count the ESCs before it made
+    } else if (r == Reach::kAddressed) {
+      mine =
+          d.adp() == esc.stationAddress() || (esc.aliasEnabled() && d.adp() == esc.stationAlias());
+    }
+    if (!mine) continue;
+    addIrq(i);
+    esc.processDatagram(d, t + leads[i]);
+    irq = esc.headerIrq();
+    from = i + 1;
+  }
+  addIrq(count);
+  if (esc.receiveTimeLatchArmed()) latched_.push_back(stop.slave);
 }
 
 }  // namespace ecsim::topology

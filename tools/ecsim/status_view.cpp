@@ -94,7 +94,7 @@ StatusSnapshot takeStatusSnapshot(topology::Segment& segment,
     s.state = slave.state();
     s.alError = (esc.alStatus() & kAlStatusErrorFlag) != 0;
     s.alStatusCode = esc.read(reg::kAlStatusCode);
-    s.frames = esc.counters().framesSeen;
+    s.frames = segment.framesSeen(i);
     s.datagrams = esc.counters().datagramsAddressed;
     for (unsigned port = 0; port < topology::kPortCount; ++port) {
       s.rxErrors += esc.reg8(reg::rxErrorCounters(port));
