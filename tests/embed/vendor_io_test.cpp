@@ -414,5 +414,23 @@ TEST_F(Loopback, OneInputFollowsAChosenOutputChannel) {
   run(0, 1, {-1, 3, -1, -1});
 }
 
+// Weidmueller_UR20_FBC.xml UR20-FBC-EC with modules of Weidmueller_UR20_IO.xml: a UR20-4DO-P in
+// slot 0 and a UR20-4DI-P in slot 1; the station's inputs follow its own outputs.
+TEST_F(Loopback, Ur20StationOutputsToItsInputs) {
+  ECSIM_REQUIRE_SHARED(sharedDir() / "esi" / "Weidmueller_UR20_IO.xml");
+  const auto esi = sharedDir() / "esi";
+  std::ostringstream s;
+  s << "  <Slave name=\"DO\" esi=\"" << (esi / "Weidmueller_UR20_FBC.xml").string()
+    << "\" product=\"#x4F911C30\" modules=\"" << (esi / "Weidmueller_UR20_IO.xml").string()
+    << "\" model=\"loopback\">\n    <Module type=\"UR20-4DO-P\"/>\n"
+    << "    <Module type=\"UR20-4DI-P\"/>\n" << kLoopFrom << "  </Slave>\n";
+  auto started = startInProcess(write(s.str()));
+  ASSERT_TRUE(started.ok()) << started.error().message();
+  ASSERT_NE(dev::digitalInputsOf(network().segment().slave(0)), nullptr);
+  EXPECT_EQ(dev::digitalInputsOf(network().segment().slave(0))->channels(), 4u);
+  EXPECT_EQ(dev::digitalOutputsOf(network().segment().slave(0))->channels(), 4u);
+  run(0, 0, {0, 1, 2, 3});
+}
+
 }  // namespace
 }  // namespace ecsim::testing
