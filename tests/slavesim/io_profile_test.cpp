@@ -189,5 +189,30 @@ TEST_F(IoProfile, BadModelsAndWiringAreErrorsWithFileAndLine) {
   }
 }
 
+// A power cycle re-creates both models (devices::restartDeviceModel): the wiring is outside
+// the devices and survives, and follows the new output terminal.
+TEST_F(IoProfile, LoopbackSurvivesPowerCyclesOfBothSlaves) {
+  auto net = build(write(slave("DO", kEl2004) +
+                         slave("DI", kEl1004, " model=\"loopback\"",
+                               "    <Param name=\"loopback.from\" value=\"DO\"/>\n")));
+  ASSERT_TRUE(net.ok()) << net.error().message();
+  auto& out = net->segment->slave(0);
+  auto& in = net->segment->slave(1);
+  for (auto* s : {&out, &in}) {
+    s->powerOff();
+    s->powerOn(0);
+    ASSERT_TRUE(s->coldStartStatus().ok()) << s->coldStartStatus().error().message();
+  }
+  auto* outOd = slavesim::objectDictionaryOf(out);
+  auto* inOd = slavesim::objectDictionaryOf(in);
+  for (bool on : {true, false, true}) {
+    ASSERT_TRUE(outOd->set<bool>(0x3001, 3, on).ok());  // EL2004 output 3
+    dev::deviceModelOf(out)->step(*outOd, AlState::kOp, 0);
+    dev::deviceModelOf(in)->step(*inOd, AlState::kOp, 0);
+    EXPECT_EQ(*inOd->get<bool>(0x3101, 3), on);  // EL1004 input 3
+    EXPECT_EQ(*inOd->get<bool>(0x3101, 1), false);
+  }
+}
+
 }  // namespace
 }  // namespace ecsim::testing
