@@ -16,7 +16,6 @@ constexpr std::uint16_t kFirstApplicationIndex = 0x2000;
 constexpr std::uint16_t kLastApplicationIndex = 0x9FFF;
 constexpr unsigned kBitsPerByte = 8;
 constexpr std::uint16_t kAnalogValueBits = 16;
-constexpr std::int64_t kRawFullScale = 32767;
 // Byte-wide entries count as digital only up to this many channels (the most a
 // DigitalOutputTerminal takes): more bytes are data (EL6001: 22 "Data In" bytes), not IO.
 constexpr std::size_t kMaxByteChannels = 32;
@@ -147,7 +146,7 @@ std::int64_t AnalogOutputTerminal::raw(unsigned channel) const {
 }
 
 double AnalogOutputTerminal::volts(unsigned channel) const {
-  return static_cast<double>(raw(channel)) / kRawFullScale * fullScaleVolts_;
+  return static_cast<double>(raw(channel)) / kAnalogRawFullScale * fullScaleVolts_;
 }
 
 void AnalogOutputTerminal::step(coe::ObjectDictionary& /*od*/, AlState state, SimTime /*now*/) {

@@ -29,7 +29,7 @@ constexpr unsigned kStatusLimit1Shift = 2;
 constexpr unsigned kStatusLimit2Shift = 4;
 constexpr std::uint16_t kStatusError = 1u << 6;
 constexpr std::uint16_t kStatusToggle = 1u << 15;
-constexpr std::int64_t kRawFullScale = 32767;
+constexpr std::int64_t kRawFullScale = kAnalogRawFullScale;
 
 // Conversions done in one step at most; beyond it the channel is taken as settled.
 constexpr std::int64_t kMaxConversionsPerStep = 10000;

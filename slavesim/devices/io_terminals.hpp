@@ -128,6 +128,9 @@ class DigitalOutputTerminal final : public Application {
   std::size_t logCapacity_{0};
 };
 
+// Raw value of +full scale (analog inputs and outputs; -full scale is its negative).
+inline constexpr std::int64_t kAnalogRawFullScale = 32767;
+
 // The objects of one analog input channel of any layout; all but `value` optional.
 struct AnalogChannelObjects {
   ObjectRef value;   // raw value, INT (-32768..32767) or UINT (0..32767 used)
