@@ -75,6 +75,14 @@ SlaveProcessData processDataFromSii(const SlaveInfo& slave) {
     SmPdoAssignment sm;
     sm.sm = static_cast<unsigned>(n);
     sm.outputs = type == SiiSyncManagerType::kOutputs;
+    // The PDOs assigned to the SM say its direction when they all say the other one (the SMC
+    // EX250's SII calls its input SM1 "Outputs"), as SOEM's ecx_map_sii sets SMtype 3/4 from
+    // the SII RxPDO/TxPDO categories.
+    auto assigned = [n](const std::vector<SiiPdo>& pdos) {
+      return std::any_of(pdos.begin(), pdos.end(),
+                         [n](const SiiPdo& p) { return p.syncManager == n; });
+    };
+    if (const bool rx = assigned(c.rxPdos); rx != assigned(c.txPdos)) sm.outputs = rx;
     for (const auto& pdo : sm.outputs ? c.rxPdos : c.txPdos) {
       if (pdo.syncManager != n) continue;
       PdoInfo info;

@@ -10,8 +10,9 @@
 //   device     ProcessDataDevice over the same dictionary (also for SII-only slaves, whose
 //              dictionary no mailbox reaches); ESI Virtual SMs are neither checked nor copied;
 //              ecsim's own devices get their model (IO terminal, CiA 402 drive), and any
-//              device whose ESI describes a CiA 402 axis a drive per axis, as its
-//              application, see devices/device_models.hpp.
+//              device whose ESI describes a CiA 402 axis a drive per axis, and another
+//              vendor's IO device the io or analog profile of its PDO entries, as its
+//              application, see devices/device_models.hpp and devices/io_profile.hpp.
 // Modular devices come with their modules already in `device` (config/esi_modules.hpp, done by
 // the topology builder). Bootstrap (BOOT state) is not modelled.
 #pragma once
@@ -41,9 +42,10 @@ struct EsiSlaveOptions {
   std::optional<EscType> escType;
   // SII string 1 (SOEM's slave name): the ESI <Name> when true, the <Type> text otherwise.
   bool deviceNameFirst{true};
-  // Attach the device model devices::deviceModelFor() names (false: plain process data).
+  // Attach the device model devices::deviceModelFor() names, for another vendor's device
+  // without one devices::chooseIoProfile's (false: plain process data).
   bool deviceModels{true};
-  // The model a topology names (model="cia402|none"); unset: devices::deviceModelFor's choice.
+  // The model a topology names (model="cia402|io|analog|loopback|none"); unset: the choice above.
   std::optional<devices::DeviceModelKind> model;
   // Persistent device state (a drive's shaft position), TopologySlave::stateFile; when set it
   // wins over models.stateFile.

@@ -1,6 +1,7 @@
 #include "slavesim/process_data.hpp"
 
 #include <algorithm>
+#include <array>
 #include <string>
 
 #include "slavesim/coe/sdo_access.hpp"
@@ -23,6 +24,16 @@ bool inProcessRam(const Esc& esc, unsigned sm) {
   const Esc::SmConfig c = esc.smConfig(sm);
   return c.start >= reg::kRegisterSpaceEnd &&
          static_cast<std::size_t>(c.start) + c.length <= esc.memorySize();
+}
+
+// Digital output terminals served by the ESC's digital I/O (the 2006-era EL2004, the EM2042:
+// output SMs of one byte at 0x0F00/0x0F01, which activate no buffer, section II Table 90): the
+// outputs are the Digital I/O Output Data register 0x0F00-0x0F03 the master's FMMU writes.
+bool inDigitalOutputRegister(const Esc& esc, unsigned sm) {
+  const Esc::SmConfig c = esc.smConfig(sm);
+  constexpr std::uint32_t first = reg::kDigitalIoOutputData.address;
+  return c.start >= first && static_cast<std::uint32_t>(c.start) + c.length <=
+                                 first + sizeof(std::uint32_t);
 }
 
 }  // namespace
@@ -105,6 +116,7 @@ void ProcessDataBinding::readOutputs(Esc& esc) {
   // the whole buffer: the ESC marks it read (SM status "interrupt read", Esc::pdiReadOutputs).
   std::size_t current = buffers_.size();
   ConstBytes src;
+  std::array<std::uint8_t, sizeof(std::uint32_t)> digitalOutputs{};
   for (const Copy& c : copies_) {
     const Buffer& b = buffers_[c.buffer];
     if (!b.outputs) continue;
@@ -112,6 +124,12 @@ void ProcessDataBinding::readOutputs(Esc& esc) {
       current = c.buffer;
       src = esc.pdiOutputsReceived(b.sm) && inProcessRam(esc, b.sm) ? esc.pdiReadOutputs(b.sm)
                                                                      : ConstBytes{};
+      if (inDigitalOutputRegister(esc, b.sm)) {
+        writeLe32(digitalOutputs, 0, esc.read(reg::kDigitalIoOutputData));
+        const Esc::SmConfig sm = esc.smConfig(b.sm);
+        src = ConstBytes(digitalOutputs.data() + (sm.start - reg::kDigitalIoOutputData.address),
+                         sm.length);
+      }
     }
     if (src.empty() || static_cast<std::size_t>(c.bitOffset) + c.bits > 8 * src.size()) continue;
     coe::copyBits(Bytes(c.value, c.valueSize), 0, src, c.bitOffset, c.bits);

@@ -5,6 +5,8 @@
 #include <fstream>
 
 #include <algorithm>
+#include <string_view>
+#include <unordered_map>
 
 #include "config/esi_modules.hpp"
 #include "protocol/closest_name.hpp"
@@ -86,22 +88,21 @@ Result<std::unique_ptr<slavesim::Slave>> SlaveFactory::make(const TopologySlave&
     if (!options.model) return at(entry, "unknown model '" + entry.model + "'");
   }
   if (!entry.params.empty()) {
-    const bool driveObjects = device->dictionary.findObject(slavesim::devices::cia402::obj::
-                                                                kControlword) != nullptr &&
-                              device->dictionary.findObject(
-                                  slavesim::devices::cia402::obj::kStatusword) != nullptr;
-    if (options.model.value_or(slavesim::devices::deviceModelFor(
-            file.vendor.id, *entry.productCode, device->profileNo, driveObjects)) ==
-        slavesim::devices::DeviceModelKind::kNone) {
-      return at(entry, "Param given, but this device has no model of ecsim with parameters" +
-                           std::string(entry.model == "none" ? " (model=\"none\")" : ""));
-    }
     std::vector<slavesim::devices::DeviceParam> params;
     for (const auto& p : entry.params) params.push_back({p.name, p.value, p.line});
     if (auto s = slavesim::devices::applyDeviceParams(options.models, params, entry.folder);
         !s.ok()) {
       return s.takeError();
     }
+    const auto& m = options.models;
+    if (!m.loopbackFrom.empty() && entry.model != "loopback") {
+      return makeError(ErrorCode::kInvalidArgument,
+                       "line " + std::to_string(m.loopbackLine) +
+                           ": loopback.from needs model=\"loopback\" on the <Slave>");
+    }
+  }
+  if (entry.model == "loopback" && options.models.loopbackFrom.empty()) {
+    return at(entry, "model=\"loopback\" needs <Param name=\"loopback.from\" value=\"SLAVE\"/>");
   }
   ECSIM_ASSIGN_OR_RETURN(const EsiDevice configured, withModules(entry, file, *device));
   std::vector<std::string> notes;
@@ -115,6 +116,10 @@ Result<std::unique_ptr<slavesim::Slave>> SlaveFactory::make(const TopologySlave&
   for (auto& n : notes) {
     warnings_.push_back("slave '" + entry.name + "' (" + entry.esiFile.string() + "): " +
                         std::move(n));
+  }
+  if (!entry.params.empty() && slavesim::devices::deviceModelOf(**slave) == nullptr) {
+    return at(entry, "Param given, but this device has no model of ecsim with parameters" +
+                         std::string(entry.model == "none" ? " (model=\"none\")" : ""));
   }
   if (auto* od = slavesim::objectDictionaryOf(**slave)) {
     for (const auto& input : entry.inputs) {
@@ -207,6 +212,79 @@ Result<EsiDevice> SlaveFactory::withModules(const TopologySlave& entry, const Es
   return configured;
 }
 
+namespace {
+
+// Binds the inputs that follow another slave's outputs ("output slave=... channel=..." in a
+// signal.N, model="loopback" with loopback.from) once every slave exists. Errors name the
+// topology file and the <Param>'s line.
+Status bindOutputSignals(const TopologyConfig& config, Segment& seg) {
+  namespace dev = slavesim::devices;
+  std::unordered_map<std::string_view, std::size_t> byName;
+  std::vector<std::string_view> names;
+  for (std::size_t i = 0; i < config.slaves.size(); ++i) {
+    byName.emplace(config.slaves[i].name, i);
+    names.push_back(config.slaves[i].name);
+  }
+  for (std::size_t i = 0; i < config.slaves.size(); ++i) {
+    const TopologySlave& entry = config.slaves[i];
+    auto fail = [&](int line, const std::string& message) {
+      return makeError(ErrorCode::kInvalidArgument,
+                       fmt::format("{}, slave '{}': line {}: {}", config.file.string(), entry.name,
+                                   line, message));
+    };
+    // The outputs of slave `from`, channel `channel`, or an error for the <Param> at `line`.
+    auto source = [&](int line, const std::string& from,
+                      unsigned channel) -> Result<std::shared_ptr<const dev::SignalSource>> {
+      auto found = byName.find(from);
+      if (found == byName.end()) {
+        return fail(line, unknownNameText("slave", from, names));
+      }
+      auto* pd = slavesim::processDataDeviceOf(seg.slave(found->second));
+      if (pd == nullptr) return fail(line, "slave '" + from + "' has no digital outputs");
+      auto s = dev::outputChannelSource(*pd, channel);
+      if (!s.ok()) return fail(line, "slave '" + from + "' " + s.error().context);
+      return s;
+    };
+    dev::DigitalInputTerminal* inputs = dev::digitalInputsOf(seg.slave(i));
+    for (const TopologyParam& p : entry.params) {
+      if (p.name.rfind("signal.", 0) != 0) continue;
+      const std::string_view value = p.value;
+      if (value.find_first_not_of(' ') == std::string_view::npos ||
+          value.substr(value.find_first_not_of(' ')).rfind("output", 0) != 0) {
+        continue;
+      }
+      auto signal = dev::parseSignal(p.value);
+      if (!signal.ok() || signal->kind() != dev::Signal::Kind::kOutput) continue;
+      if (inputs == nullptr) return fail(p.line, "the device has no digital inputs to drive");
+      const unsigned channel = static_cast<unsigned>(std::stoul(p.name.substr(7)));
+      ECSIM_ASSIGN_OR_RETURN(auto src,
+                             source(p.line, signal->outputSlave(), signal->outputChannel()));
+      inputs->setScript(channel, signal->bind(std::move(src)));
+    }
+    if (entry.model != "loopback") continue;
+    int line = entry.line;
+    std::string from;
+    for (const TopologyParam& p : entry.params) {
+      if (p.name == "loopback.from") {
+        line = p.line;
+        from = p.value;
+      }
+    }
+    if (inputs == nullptr) return fail(entry.line, "model loopback: no digital inputs");
+    if (auto check = source(line, from, 1); !check.ok()) return check.takeError();
+    auto* pd = slavesim::processDataDeviceOf(seg.slave(byName.at(from)));
+    const unsigned count =
+        std::min(inputs->channels(), dev::digitalOutputsIn(pd->application())->channels());
+    for (unsigned c = 1; c <= count; ++c) {
+      ECSIM_ASSIGN_OR_RETURN(auto src, source(line, from, c));
+      inputs->setScript(c, dev::Signal::output(from, c).bind(std::move(src)));
+    }
+  }
+  return okStatus();
+}
+
+}  // namespace
+
 Result<Network> buildNetwork(const TopologyConfig& config) {
   if (config.slaves.size() > kMaxSlaves) {
     return makeError(ErrorCode::kInvalidArgument,
@@ -234,6 +312,7 @@ Result<Network> buildNetwork(const TopologyConfig& config) {
     seg.setDelays(i, entry.processingDelayNs.value_or(type.processingDelayNs),
                   entry.forwardingDelayNs.value_or(type.forwardingDelayNs));
   }
+  ECSIM_TRY(bindOutputSignals(config, seg));
   seg.setMasterCable(config.masterCableMetres);
   net.cables.push_back({"master", 0, 0});
   for (const auto& link : config.links) {

@@ -22,6 +22,7 @@ constexpr std::uint32_t kProductSsiEncoder = 0x00005001;
 constexpr std::uint32_t kBeckhoffVendorId = 0x00000002;
 constexpr std::uint32_t kBeckhoffEj5002 = 0x138A2852;
 constexpr std::uint32_t kProfileDrive = 402;
+constexpr std::uint32_t kProfileModularDevice = 5001;  // ETG.5001 MDP
 constexpr std::uint16_t kEncoderResolution = 0x2011;
 constexpr std::uint8_t kIdentityVendorSub = 1;  // 0x1018:01 vendor id
 constexpr std::uint16_t kAxisIndexStep = 0x800;  // ETG.6010 multi-axis layout
@@ -103,13 +104,25 @@ DeviceModelKind deviceModelFor(std::uint32_t vendorId, std::uint32_t productCode
   return drive ? DeviceModelKind::kCia402Drive : DeviceModelKind::kNone;
 }
 
+DeviceModelKind chooseIoProfile(coe::ObjectDictionary& od, std::optional<std::uint32_t> profileNo) {
+  if (profileNo && *profileNo != kProfileModularDevice) return DeviceModelKind::kNone;
+  const IoProfileChoice choice = ioProfileOf(od);
+  if (choice.analog) return DeviceModelKind::kAnalog;
+  return choice.digital ? DeviceModelKind::kIo : DeviceModelKind::kNone;
+}
+
 std::optional<DeviceModelKind> deviceModelByName(std::string_view name) {
   if (name == "cia402") return DeviceModelKind::kCia402Drive;
+  if (name == "io") return DeviceModelKind::kIo;
+  if (name == "analog") return DeviceModelKind::kAnalog;
+  if (name == "loopback") return DeviceModelKind::kLoopback;
   if (name == "none") return DeviceModelKind::kNone;
   return std::nullopt;
 }
 
-std::vector<std::string> deviceModelNames() { return {"cia402", "none"}; }
+std::vector<std::string> deviceModelNames() {
+  return {"cia402", "io", "analog", "loopback", "none"};
+}
 
 unsigned cia402AxisCount(const coe::ObjectDictionary& od) {
   unsigned n = 0;
@@ -129,7 +142,9 @@ Status attachDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,
   device.setApplication(nullptr);  // the old model goes first (and saves its state)
   coe::ObjectDictionary& od = device.dictionary();
   if (!options.scripts.empty() && kind != DeviceModelKind::kDigitalInputs &&
-      kind != DeviceModelKind::kAnalogInputs && kind != DeviceModelKind::kSsiEncoder) {
+      kind != DeviceModelKind::kAnalogInputs && kind != DeviceModelKind::kSsiEncoder &&
+      kind != DeviceModelKind::kIo && kind != DeviceModelKind::kAnalog &&
+      kind != DeviceModelKind::kLoopback) {
     return makeError(ErrorCode::kInvalidArgument,
                      "input scripts (signal.N) need an input terminal or an encoder");
   }
@@ -168,6 +183,31 @@ Status attachDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,
       return installDrives(device, drive, options.emergencies);
     case DeviceModelKind::kRobotDrive:
       return installDrive(device, RobotDrive::create(od, drive), options.emergencies);
+    case DeviceModelKind::kIo:
+    case DeviceModelKind::kLoopback: {
+      ECSIM_ASSIGN_OR_RETURN(auto io, makeDigitalIo(od));
+      if (!options.scripts.empty() && !io->digitalInputs) {
+        return makeError(ErrorCode::kInvalidArgument,
+                         "input scripts (signal.N): the device has no digital inputs");
+      }
+      if (io->digitalInputs) ECSIM_TRY(applyScripts(*io->digitalInputs, options.scripts));
+      if (kind == DeviceModelKind::kLoopback && !io->digitalInputs) {
+        return makeError(ErrorCode::kInvalidArgument,
+                         "model loopback: the device has no digital inputs");
+      }
+      device.setApplication(std::move(io));
+      return okStatus();
+    }
+    case DeviceModelKind::kAnalog: {
+      ECSIM_ASSIGN_OR_RETURN(auto io, makeAnalogIo(od, options.analog));
+      if (!options.scripts.empty() && !io->analogInputs) {
+        return makeError(ErrorCode::kInvalidArgument,
+                         "input scripts (signal.N): the device has no analog inputs");
+      }
+      if (io->analogInputs) ECSIM_TRY(applyScripts(*io->analogInputs, options.scripts));
+      device.setApplication(std::move(io));
+      return okStatus();
+    }
     case DeviceModelKind::kSsiEncoder: {
       EncoderTerminalOptions encoder{drive.encoder, drive.initialShaftAngle, drive.stateFile,
                                      drive.stateSaveInterval};
@@ -194,8 +234,8 @@ Status restartDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,
       if (terminal.script(c)) next.scripts.emplace_back(c, *terminal.script(c));
     }
   };
-  if (auto* di = dynamic_cast<DigitalInputTerminal*>(old)) carryScripts(*di);
-  if (auto* ai = dynamic_cast<AnalogInputTerminal*>(old)) carryScripts(*ai);
+  if (auto* di = digitalInputsIn(old)) carryScripts(*di);
+  if (auto* ai = analogInputsIn(old)) carryScripts(*ai);
   std::vector<std::pair<double, std::uint8_t>> encoderChannels;  // shaft angle, faults
   if (auto* enc = dynamic_cast<SsiEncoderTerminal*>(old)) {
     carryScripts(*enc);
@@ -235,15 +275,19 @@ RobotDrive* robotDriveOf(Slave& slave) {
 }
 
 DigitalInputTerminal* digitalInputsOf(Slave& slave) {
-  return dynamic_cast<DigitalInputTerminal*>(deviceModelOf(slave));
+  return digitalInputsIn(deviceModelOf(slave));
 }
 
 DigitalOutputTerminal* digitalOutputsOf(Slave& slave) {
-  return dynamic_cast<DigitalOutputTerminal*>(deviceModelOf(slave));
+  return digitalOutputsIn(deviceModelOf(slave));
 }
 
 AnalogInputTerminal* analogInputsOf(Slave& slave) {
-  return dynamic_cast<AnalogInputTerminal*>(deviceModelOf(slave));
+  return analogInputsIn(deviceModelOf(slave));
+}
+
+AnalogOutputTerminal* analogOutputsOf(Slave& slave) {
+  return analogOutputsIn(deviceModelOf(slave));
 }
 
 SsiEncoderTerminal* encoderTerminalOf(Slave& slave) {
@@ -392,6 +436,12 @@ Status applyDeviceParams(DeviceModelOptions& options, const std::vector<DevicePa
       auto signal = parseSignal(p.value, baseDir);
       if (!signal.ok()) return paramError(p, signal.error().message());
       options.scripts.emplace_back(*channel, std::move(signal).value());
+      continue;
+    }
+    if (p.name == "loopback.from") {
+      if (p.value.empty()) return paramError(p, "needs the name of a slave");
+      options.loopbackFrom = p.value;
+      options.loopbackLine = p.line;
       continue;
     }
     if (p.name.rfind("gains.", 0) == 0) {

@@ -15,8 +15,10 @@
 // controlword 0x6040 and statusword 0x6041 (a device of another profile, e.g. 5001 MDP, may use
 // 0x6040 for something else). The drive binds to the device's own objects and PDO entries; a
 // device with further axes (0x6840/0x6841, 0x7040/0x7041, ...) gets one drive per axis
-// (MultiAxisDrive). Other devices keep the plain ProcessDataDevice. A topology's
-// model="cia402|none" overrides the choice (DeviceModelKind by name: deviceModelByName).
+// (MultiAxisDrive). Any other device whose ESI gives no profile or MDP 5001 gets the analog
+// profile when its PDOs map analog values, the io profile when they map digital entries
+// (io_profile.hpp, chooseIoProfile); the rest keep the plain ProcessDataDevice. A topology's
+// model="cia402|io|analog|loopback|none" overrides the choice (deviceModelByName).
 #pragma once
 
 #include <cstdint>
@@ -30,6 +32,7 @@
 #include "protocol/result.hpp"
 #include "slavesim/devices/cia402_drive.hpp"
 #include "slavesim/devices/encoder_terminal.hpp"
+#include "slavesim/devices/io_profile.hpp"
 #include "slavesim/devices/io_terminals.hpp"
 #include "slavesim/devices/multi_axis_drive.hpp"
 #include "slavesim/devices/robot_drive.hpp"
@@ -46,6 +49,9 @@ enum class DeviceModelKind : std::uint8_t {
   kCia402Drive,
   kRobotDrive,
   kSsiEncoder,
+  kIo,        // io_profile.hpp: digital inputs and outputs of the device's own PDO entries
+  kAnalog,    // analog inputs and outputs of the device's own PDO entries
+  kLoopback,  // io, inputs following another slave's outputs (loopback.from)
 };
 
 // hasDriveObjects: the device's dictionary has 0x6040 and 0x6041.
@@ -53,7 +59,13 @@ DeviceModelKind deviceModelFor(std::uint32_t vendorId, std::uint32_t productCode
                                std::optional<std::uint32_t> profileNo = std::nullopt,
                                bool hasDriveObjects = false);
 
-// The model a topology's model="NAME" names ("cia402", "none"); nullopt for another name.
+// For a device deviceModelFor() gives none: kAnalog, kIo or kNone from the PDO entries of its
+// dictionary when its ESI gives no profile or MDP 5001 (io_profile.hpp), else kNone.
+DeviceModelKind chooseIoProfile(coe::ObjectDictionary& od,
+                                std::optional<std::uint32_t> profileNo = std::nullopt);
+
+// The model a topology's model="NAME" names ("cia402", "io", "analog", "loopback", "none");
+// nullopt for another name.
 std::optional<DeviceModelKind> deviceModelByName(std::string_view name);
 // The names deviceModelByName takes, for messages.
 std::vector<std::string> deviceModelNames();
@@ -75,6 +87,10 @@ struct DeviceModelOptions {
   // Input terminals: scripted channels (1-based; digital on at >= 0.5, analog in volts,
   // encoder shaft in turns).
   std::vector<std::pair<unsigned, Signal>> scripts;
+  // model="loopback": the slave whose digital outputs the inputs follow (loopback.from), and
+  // the line of that <Param>; bound by the topology builder.
+  std::string loopbackFrom;
+  int loopbackLine{0};
 };
 
 // Attaches the model to `device` (kNone: removes any). Scripts for a model without scripted
@@ -102,5 +118,6 @@ DigitalInputTerminal* digitalInputsOf(Slave& slave);
 DigitalOutputTerminal* digitalOutputsOf(Slave& slave);
 AnalogInputTerminal* analogInputsOf(Slave& slave);
 SsiEncoderTerminal* encoderTerminalOf(Slave& slave);
+AnalogOutputTerminal* analogOutputsOf(Slave& slave);
 
 }  // namespace ecsim::slavesim::devices

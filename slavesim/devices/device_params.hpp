@@ -22,7 +22,9 @@
 //   signal.N   input terminals: channel N driven by a script in the text form of signal.hpp
 //              ("square period=0.5", "sine amplitude=5 frequency=2", "csv file=trace.csv"),
 //              digital channels on at >= 0.5, analog channels in volts; CSV files relative to
-//              `baseDir` (the topology file's folder)
+//              `baseDir` (the topology file's folder); "output slave=DO1 channel=3" follows
+//              another slave's digital output (bound by the topology builder)
+//   loopback.from  model="loopback": the slave whose output channel n input channel n follows
 // The gains are resolved after all other parameters, so their order in the file does not
 // matter. An unknown name or a value that is not a number of the right range is an error
 // naming the parameter's line.

@@ -29,7 +29,7 @@ constexpr unsigned kStatusLimit1Shift = 2;
 constexpr unsigned kStatusLimit2Shift = 4;
 constexpr std::uint16_t kStatusError = 1u << 6;
 constexpr std::uint16_t kStatusToggle = 1u << 15;
-constexpr std::int64_t kRawFullScale = 32767;
+constexpr std::int64_t kRawFullScale = kAnalogRawFullScale;
 
 // Conversions done in one step at most; beyond it the channel is taken as settled.
 constexpr std::int64_t kMaxConversionsPerStep = 10000;
@@ -39,13 +39,15 @@ Error missing(std::uint16_t index, unsigned sub) {
                                              std::to_string(index) + ":" + std::to_string(sub));
 }
 
-Result<std::vector<ObjectRef>> channelRefs(coe::ObjectDictionary& od, std::uint16_t index,
-                                           unsigned channels) {
-  std::vector<ObjectRef> refs;
+constexpr std::size_t kMaxDigitalOutputs = 32;  // OutputChange::outputs has 32 bits
+
+Result<std::vector<DigitalChannel>> channelRefs(coe::ObjectDictionary& od, std::uint16_t index,
+                                                unsigned channels) {
+  std::vector<DigitalChannel> refs;
   for (unsigned c = 1; c <= channels; ++c) {
     ObjectRef r(od, index, static_cast<std::uint8_t>(c));
     if (!r) return missing(index, c);
-    refs.push_back(r);
+    refs.push_back({r, 0});
   }
   return refs;
 }
@@ -64,8 +66,13 @@ unsigned limitCode(bool enabled, std::int64_t value, std::int64_t limit) {
 Result<std::unique_ptr<DigitalInputTerminal>> DigitalInputTerminal::create(
     coe::ObjectDictionary& od, std::uint16_t index, unsigned channels) {
   ECSIM_ASSIGN_OR_RETURN(auto refs, channelRefs(od, index, channels));
+  return create(std::move(refs));
+}
+
+std::unique_ptr<DigitalInputTerminal> DigitalInputTerminal::create(
+    std::vector<DigitalChannel> channels) {
   std::unique_ptr<DigitalInputTerminal> t(new DigitalInputTerminal());
-  for (const ObjectRef& r : refs) t->channels_.push_back({r, std::nullopt});
+  for (const DigitalChannel& c : channels) t->channels_.push_back({c, std::nullopt});
   return t;
 }
 
@@ -79,7 +86,7 @@ void DigitalInputTerminal::clearScript(unsigned channel) {
 }
 
 bool DigitalInputTerminal::input(unsigned channel) const {
-  return channel >= 1 && channel <= channels_.size() && channels_[channel - 1].value.get() != 0;
+  return channel >= 1 && channel <= channels_.size() && channels_[channel - 1].value.get();
 }
 
 void DigitalInputTerminal::step(coe::ObjectDictionary& /*od*/, AlState /*state*/, SimTime now) {
@@ -93,7 +100,7 @@ void DigitalInputTerminal::sync(coe::ObjectDictionary& /*od*/, unsigned signal, 
 
 void DigitalInputTerminal::latch(SimTime now) {
   for (Channel& c : channels_) {
-    if (c.script) c.value.set(c.script->value(now) >= 0.5 ? 1 : 0);
+    if (c.script) c.value.set(c.script->value(now) >= 0.5);
   }
 }
 
@@ -101,12 +108,22 @@ void DigitalInputTerminal::latch(SimTime now) {
 
 Result<std::unique_ptr<DigitalOutputTerminal>> DigitalOutputTerminal::create(
     coe::ObjectDictionary& od, std::uint16_t index, unsigned channels) {
-  if (channels > 32) {
+  if (channels > kMaxDigitalOutputs) {
     return makeError(ErrorCode::kInvalidArgument, "digital outputs: at most 32 channels");
   }
   ECSIM_ASSIGN_OR_RETURN(auto refs, channelRefs(od, index, channels));
+  return create(std::move(refs));
+}
+
+Result<std::unique_ptr<DigitalOutputTerminal>> DigitalOutputTerminal::create(
+    std::vector<DigitalChannel> channels) {
+  if (channels.size() > kMaxDigitalOutputs) {
+    return makeError(ErrorCode::kInvalidArgument,
+                     "digital outputs: " + std::to_string(channels.size()) +
+                         " channels, at most 32");
+  }
   std::unique_ptr<DigitalOutputTerminal> t(new DigitalOutputTerminal());
-  t->channels_ = std::move(refs);
+  t->channels_ = std::move(channels);
   return t;
 }
 
@@ -150,7 +167,7 @@ void DigitalOutputTerminal::apply(AlState state, SimTime now) {
   std::uint32_t next = 0;
   if (state == AlState::kOp) {
     for (std::size_t c = 0; c < channels_.size(); ++c) {
-      if (channels_[c].get() != 0) next |= 1u << c;
+      if (channels_[c].get()) next |= 1u << c;
     }
   }
   if (next == outputs_) return;
@@ -163,16 +180,11 @@ void DigitalOutputTerminal::apply(AlState state, SimTime now) {
 
 Result<std::unique_ptr<AnalogInputTerminal>> AnalogInputTerminal::create(
     coe::ObjectDictionary& od, unsigned channels, AnalogInputOptions options) {
-  if (options.conversionPeriod <= 0 || options.fullScaleVolts <= 0.0) {
-    return makeError(ErrorCode::kInvalidArgument,
-                     "analog inputs: conversion period and full scale must be > 0");
-  }
-  std::unique_ptr<AnalogInputTerminal> t(new AnalogInputTerminal());
-  t->options_ = options;
+  std::vector<AnalogChannelObjects> objects;
   for (unsigned c = 0; c < channels; ++c) {
     const auto in = static_cast<std::uint16_t>(kAnalogInputBase + kChannelStride * c);
     const auto set = static_cast<std::uint16_t>(kAnalogSettingsBase + kChannelStride * c);
-    Channel ch;
+    AnalogChannelObjects ch;
     ch.status = ObjectRef(od, in, kSubStatus);
     ch.value = ObjectRef(od, in, kSubValue);
     if (!ch.status) return missing(in, kSubStatus);
@@ -184,6 +196,24 @@ Result<std::unique_ptr<AnalogInputTerminal>> AnalogInputTerminal::create(
     ch.limit1 = ObjectRef(od, set, kSubLimit1);
     ch.limit2 = ObjectRef(od, set, kSubLimit2);
     ch.filterMs = ObjectRef(od, set, kSubFilterMs);
+    objects.push_back(ch);
+  }
+  return create(std::move(objects), od, options);
+}
+
+Result<std::unique_ptr<AnalogInputTerminal>> AnalogInputTerminal::create(
+    std::vector<AnalogChannelObjects> channels, coe::ObjectDictionary& od,
+    AnalogInputOptions options) {
+  if (options.conversionPeriod <= 0 || options.fullScaleVolts <= 0.0) {
+    return makeError(ErrorCode::kInvalidArgument,
+                     "analog inputs: conversion period and full scale must be > 0");
+  }
+  std::unique_ptr<AnalogInputTerminal> t(new AnalogInputTerminal());
+  t->options_ = options;
+  for (AnalogChannelObjects& c : channels) {
+    if (!c.value) return makeError(ErrorCode::kNotFound, "analog inputs: a channel has no value");
+    Channel ch;
+    ch.objects = c;
     t->channels_.push_back(std::move(ch));
   }
   t->errorRegister_ = ObjectRef(od, error_register::kIndex, 0);
@@ -211,8 +241,8 @@ std::int16_t AnalogInputTerminal::rawValue(double volts) const {
 
 void AnalogInputTerminal::convert(Channel& c, SimTime t) {
   const double x = c.script->value(t);
-  const double tauMs = static_cast<double>(c.filterMs.get(10));
-  if (c.filterOn.get() != 0 && tauMs > 0.0 && c.primed) {
+  const double tauMs = static_cast<double>(c.objects.filterMs.get(10));
+  if (c.objects.filterOn.get() != 0 && tauMs > 0.0 && c.primed) {
     const double period = static_cast<double>(options_.conversionPeriod) / kNsPerMs;
     c.filtered += (1.0 - std::exp(-period / tauMs)) * (x - c.filtered);
   } else {
@@ -247,24 +277,32 @@ void AnalogInputTerminal::update(SimTime now) {
   for (Channel& c : channels_) {
     if (!c.script) continue;
     for (std::int64_t k = 0; k < pending; ++k) convert(c, nextConversion_ + k * period);
+    AnalogChannelObjects& o = c.objects;
     const double scaled = c.filtered / options_.fullScaleVolts * kRawFullScale;
-    const std::int64_t value = rawValue(c.filtered);
+    const double lowest = o.unsignedValue ? 0.0 : -static_cast<double>(kRawFullScale);
+    const std::int64_t raw = rawValue(c.filtered);
+    const std::int64_t value = o.unsignedValue ? std::max<std::int64_t>(raw, 0) : raw;
     std::uint16_t status = 0;
-    if (scaled < -static_cast<double>(kRawFullScale)) status |= kStatusUnderrange;
+    if (scaled < lowest) status |= kStatusUnderrange;
     if (scaled > static_cast<double>(kRawFullScale)) status |= kStatusOverrange;
     if ((status & (kStatusUnderrange | kStatusOverrange)) != 0) status |= kStatusError;
     status = static_cast<std::uint16_t>(
-        status | limitCode(c.limit1On.get() != 0, value, c.limit1.get()) << kStatusLimit1Shift);
+        status | limitCode(o.limit1On.get() != 0, value, o.limit1.get()) << kStatusLimit1Shift);
     status = static_cast<std::uint16_t>(
-        status | limitCode(c.limit2On.get() != 0, value, c.limit2.get()) << kStatusLimit2Shift);
+        status | limitCode(o.limit2On.get() != 0, value, o.limit2.get()) << kStatusLimit2Shift);
     if (c.toggle) status |= kStatusToggle;
-    c.value.set(value);
-    c.status.set(status);
+    o.value.set(value);
+    o.status.set(status);
+    o.underrange.set((status & kStatusUnderrange) != 0);
+    o.overrange.set((status & kStatusOverrange) != 0);
+    o.error.set((status & kStatusError) != 0);
+    o.toggle.set(c.toggle);
+    c.error = (status & kStatusError) != 0;
   }
   // Under- or overrange of a voltage input: generic + voltage, as long as a channel shows it.
   std::uint8_t reg = 0;
   for (const Channel& c : channels_) {
-    if ((c.status.getUnsigned() & kStatusError) != 0) {
+    if (c.script ? c.error : (c.objects.status.getUnsigned() & kStatusError) != 0) {
       reg |= error_register::kGeneric | error_register::kVoltage;
     }
   }

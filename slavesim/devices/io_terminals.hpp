@@ -2,11 +2,13 @@
 // Each is an Application of the slave's ProcessDataDevice: it works on the dictionary entries
 // the PDO binding copies to and from the SyncManager buffers, never on the ESC itself.
 //
-//   DigitalInputTerminal   channels = BOOL entries index:01..index:N (ECS1008: 0x6000:01-08).
+//   DigitalInputTerminal   channels = BOOL entries index:01..index:N (ECS1008: 0x6000:01-08), or
+//                          any list of bits of entries (a vendor device's PDO entries, io_profile.hpp).
 //                          A channel with a script is driven by it (on when the value is >=
 //                          0.5); a channel without one keeps whatever value the dictionary holds
 //                          (set by a topology <Input>, a test or SDO), so scripts are optional.
-//   DigitalOutputTerminal  channels = BOOL entries index:01..index:N (ECS2008: 0x7000:01-08).
+//   DigitalOutputTerminal  channels = BOOL entries index:01..index:N (ECS2008: 0x7000:01-08), or
+//                          any list of bits of entries, at most 32.
 //                          The physical outputs follow the dictionary in OP and are off (safe
 //                          state) in every other AL state. Read them with output()/outputs(),
 //                          be called on each change, or keep a log of changes.
@@ -42,12 +44,28 @@
 
 namespace ecsim::slavesim::devices {
 
+// One digital channel: bit `bit` of a dictionary entry (0 for a BOOL entry, 0-7 for the bits
+// of a byte-wide entry).
+struct DigitalChannel {
+  ObjectRef entry;
+  std::uint8_t bit{0};
+
+  bool get() const { return ((entry.getUnsigned() >> bit) & 1u) != 0; }
+  void set(bool on) {
+    const std::uint64_t mask = std::uint64_t{1} << bit;
+    const std::uint64_t v = entry.getUnsigned();
+    entry.set(static_cast<std::int64_t>(on ? v | mask : v & ~mask));
+  }
+};
+
 class DigitalInputTerminal final : public Application {
  public:
   // kNotFound when index:01..index:channels are not all in the dictionary.
   static Result<std::unique_ptr<DigitalInputTerminal>> create(coe::ObjectDictionary& od,
                                                               std::uint16_t index = 0x6000,
                                                               unsigned channels = 8);
+  // Over the given channels (channel n = channels[n - 1]).
+  static std::unique_ptr<DigitalInputTerminal> create(std::vector<DigitalChannel> channels);
 
   unsigned channels() const { return static_cast<unsigned>(channels_.size()); }
   void setScript(unsigned channel, Signal signal);
@@ -66,7 +84,7 @@ class DigitalInputTerminal final : public Application {
  private:
   void latch(SimTime now);
   struct Channel {
-    ObjectRef value;
+    DigitalChannel value;
     std::optional<Signal> script;
   };
   std::vector<Channel> channels_;
@@ -82,6 +100,8 @@ class DigitalOutputTerminal final : public Application {
   static Result<std::unique_ptr<DigitalOutputTerminal>> create(coe::ObjectDictionary& od,
                                                                std::uint16_t index = 0x7000,
                                                                unsigned channels = 8);
+  // Over the given channels (at most 32).
+  static Result<std::unique_ptr<DigitalOutputTerminal>> create(std::vector<DigitalChannel> channels);
 
   unsigned channels() const { return static_cast<unsigned>(channels_.size()); }
   bool output(unsigned channel) const;
@@ -101,11 +121,25 @@ class DigitalOutputTerminal final : public Application {
 
  private:
   void apply(AlState state, SimTime now);
-  std::vector<ObjectRef> channels_;
+  std::vector<DigitalChannel> channels_;
   std::uint32_t outputs_{0};
   std::function<void(SimTime, std::uint32_t)> observer_;
   std::vector<OutputChange> log_;
   std::size_t logCapacity_{0};
+};
+
+// Raw value of +full scale (analog inputs and outputs; -full scale is its negative).
+inline constexpr std::int64_t kAnalogRawFullScale = 32767;
+
+// The objects of one analog input channel of any layout; all but `value` optional.
+struct AnalogChannelObjects {
+  ObjectRef value;   // raw value, INT (-32768..32767) or UINT (0..32767 used)
+  bool unsignedValue{false};
+  ObjectRef status;  // status word or byte with the bits of the ECS3102 layout above
+  // Single status bits (MDP 5001 layout: 0x60n0:01 Underrange, :02 Overrange, :07 Error,
+  // :10 TxPDO Toggle).
+  ObjectRef underrange, overrange, error, toggle;
+  ObjectRef filterOn, limit1On, limit2On, limit1, limit2, filterMs;  // ECS3102 settings
 };
 
 struct AnalogInputOptions {
@@ -118,6 +152,10 @@ class AnalogInputTerminal final : public Application {
   static Result<std::unique_ptr<AnalogInputTerminal>> create(coe::ObjectDictionary& od,
                                                              unsigned channels = 2,
                                                              AnalogInputOptions options = {});
+  // Over the given channels (a vendor device's entries, io_profile.hpp).
+  static Result<std::unique_ptr<AnalogInputTerminal>> create(
+      std::vector<AnalogChannelObjects> channels, coe::ObjectDictionary& od,
+      AnalogInputOptions options = {});
 
   unsigned channels() const { return static_cast<unsigned>(channels_.size()); }
   // Volts as a function of time.
@@ -137,12 +175,12 @@ class AnalogInputTerminal final : public Application {
  private:
   void update(SimTime now);
   struct Channel {
-    ObjectRef status, value;
-    ObjectRef filterOn, limit1On, limit2On, limit1, limit2, filterMs;
+    AnalogChannelObjects objects;
     std::optional<Signal> script;
     double filtered{0.0};
     bool primed{false};  // filter state initialised
     bool toggle{false};
+    bool error{false};  // under- or overrange at the last conversion
   };
   void convert(Channel& c, SimTime t);
 

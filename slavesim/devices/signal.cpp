@@ -91,6 +91,14 @@ Signal Signal::table(std::vector<Point> points, bool loop, bool step) {
   return s;
 }
 
+Signal Signal::output(std::string slave, unsigned channel) {
+  Signal s;
+  s.kind_ = Kind::kOutput;
+  s.a_ = channel;
+  s.outputSlave_ = std::move(slave);
+  return s;
+}
+
 Result<Signal> Signal::fromCsv(const std::filesystem::path& path, bool loop, bool step) {
   // Read whole and at once: a FIFO or a device here would hold the serve loop (ecsim ctl input).
   ECSIM_ASSIGN_OR_RETURN(const std::string content, readRegularFile(path, kMaxTextFileBytes));
@@ -155,6 +163,8 @@ double Signal::value(SimTime t) const {
     }
     case Kind::kTable:
       return tableValue(s);
+    case Kind::kOutput:
+      return source_ ? source_->value(t) : 0.0;
   }
   return 0.0;
 }
@@ -220,11 +230,21 @@ Result<Signal> parseSignal(std::string_view text, const std::filesystem::path& b
     const bool loop = num("loop", 0.0) != 0.0;
     const bool step = num("step", 0.0) != 0.0;
     if (problem.empty() && args.empty()) return Signal::fromCsv(path, loop, step);
+  } else if (kind == "output") {
+    auto slave = args.find("slave");
+    const double channel = num("channel", 0.0);
+    if (slave == args.end() || slave->second.empty() || channel < 1 || channel > 255 ||
+        channel != std::floor(channel)) {
+      return makeError(ErrorCode::kParse, "signal \"" + std::string(text) +
+                                              "\": output needs slave=NAME and channel=1..255");
+    }
+    out = Signal::output(slave->second, static_cast<unsigned>(channel));
+    args.erase(slave);
   } else {
     return makeError(ErrorCode::kParse,
                      "signal \"" + std::string(text) + "\": unknown kind '" + kind +
-                         "' (constant, square, sine, ramp, csv or a number)" +
-                         didYouMean(kind, {"constant", "square", "sine", "ramp", "csv"}));
+                         "' (constant, square, sine, ramp, csv, output or a number)" +
+                         didYouMean(kind, {"constant", "square", "sine", "ramp", "csv", "output"}));
   }
   if (problem.empty() && !args.empty()) problem = "unknown parameter '" + args.begin()->first + "'";
   if (!problem.empty()) {

@@ -9,6 +9,8 @@
 //   "sine amplitude=5 frequency=2 offset=0 phase=0"          (phase in seconds, like square)
 //   "ramp start=0 slope=1 min=-10 max=10 period=0"           (period > 0: sawtooth)
 //   "csv file=path/to/trace.csv loop=0 step=0"
+//   "output slave=DO1 channel=3"             another slave's digital output channel (1/0);
+//                                            0 until the topology builder binds it
 // Times are seconds of simulation time. A CSV file has one "time,value" row per line (seconds,
 // ascending; blank lines, '#' comments and a non-numeric header line are skipped); values are
 // interpolated linearly (step=1: held until the next row), held after the last row or repeated
@@ -17,6 +19,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -26,9 +29,17 @@
 
 namespace ecsim::slavesim::devices {
 
+// Where a kOutput signal reads its value (another slave's output channel), bound once the whole
+// network is built (topology/network_builder.cpp). value() must not allocate.
+class SignalSource {
+ public:
+  virtual ~SignalSource() = default;
+  virtual double value(SimTime t) const = 0;
+};
+
 class Signal {
  public:
-  enum class Kind : std::uint8_t { kConstant, kSquare, kSine, kRamp, kTable };
+  enum class Kind : std::uint8_t { kConstant, kSquare, kSine, kRamp, kTable, kOutput };
   struct Point {
     double time{0.0};  // seconds
     double value{0.0};
@@ -47,6 +58,16 @@ class Signal {
                      double period = 0.0);
   // Points must be ascending in time (checked by fromCsv; here the caller's duty).
   static Signal table(std::vector<Point> points, bool loop = false, bool step = false);
+  // Output channel `channel` (1-based) of the slave named `slave`; unbound until bind().
+  static Signal output(std::string slave, unsigned channel);
+  // A kOutput signal reading `source`.
+  Signal bind(std::shared_ptr<const SignalSource> source) const {
+    Signal s = *this;
+    s.source_ = std::move(source);
+    return s;
+  }
+  const std::string& outputSlave() const { return outputSlave_; }
+  unsigned outputChannel() const { return static_cast<unsigned>(a_); }
   // Reads a "time,value" CSV file; errors name the file and line.
   static Result<Signal> fromCsv(const std::filesystem::path& path, bool loop = false,
                                 bool step = false);
@@ -76,6 +97,8 @@ class Signal {
   bool loop_{false};
   bool step_{false};
   std::vector<Point> points_;
+  std::string outputSlave_;                        // kOutput
+  std::shared_ptr<const SignalSource> source_;     // kOutput, once bound
 };
 
 // Parses the text form above. Relative CSV paths are resolved against `baseDir`.
