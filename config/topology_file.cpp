@@ -77,7 +77,7 @@ const xml::Names kSlaveNames{{"name", "esi", "product", "revision", "device", "e
                              {"Clock", "Input", "Param", "Module"},
                              {"Clock"}};
 // <Slave model="...">: the device models a topology may choose (docs/devices.md).
-const std::vector<std::string_view> kModelNames{"cia402", "none"};
+const std::vector<std::string_view> kModelNames{"cia402", "encoder", "none"};
 const xml::Names kClockNames{{"offsetNs", "driftPpm"}};
 const xml::Names kInputNames{{"entry", "value"}};
 const xml::Names kParamNames{{"name", "value"}};

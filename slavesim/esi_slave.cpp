@@ -112,8 +112,12 @@ Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiDevice& device, std::st
     const bool driveObjects =
         od->findEntry(devices::cia402::obj::kControlword, 0) != nullptr &&
         od->findEntry(devices::cia402::obj::kStatusword, 0) != nullptr;
-    const devices::DeviceModelKind kind = options.model.value_or(devices::deviceModelFor(
+    devices::DeviceModelKind kind = options.model.value_or(devices::deviceModelFor(
         sii.identity.vendorId, sii.identity.productCode, device.profileNo, driveObjects));
+    if (!options.model && kind == devices::DeviceModelKind::kNone &&
+        !devices::counterValueChannels(*od).empty()) {
+      kind = devices::DeviceModelKind::kEncoder;  // counter values in its TxPDOs
+    }
     ECSIM_TRY(devices::attachDeviceModel(*pd, kind, modelOptions));
     // A power cycle re-creates the model as built here (plus what outlives the power).
     pd->setRestart([kind, modelOptions](ProcessDataDevice& d) {

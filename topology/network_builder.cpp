@@ -10,6 +10,7 @@
 #include "protocol/closest_name.hpp"
 #include "protocol/read_file.hpp"
 #include "protocol/sii.hpp"
+#include "slavesim/coe/od_from_esi.hpp"
 #include "slavesim/devices/device_params.hpp"
 #include "slavesim/esi_slave.hpp"
 #include "slavesim/generic_slave.hpp"
@@ -90,9 +91,17 @@ Result<std::unique_ptr<slavesim::Slave>> SlaveFactory::make(const TopologySlave&
                                                                 kControlword) != nullptr &&
                               device->dictionary.findObject(
                                   slavesim::devices::cia402::obj::kStatusword) != nullptr;
+    // A device with counter values in its TxPDOs gets the encoder profile (esi_slave.cpp); that
+    // needs its dictionary as built (2006-era files have none of their own).
+    const auto counters = [&] {
+      return !slavesim::devices::counterValueChannels(
+                  slavesim::coe::buildObjectDictionary(*device, {file.vendor.id}))
+                  .empty();
+    };
     if (options.model.value_or(slavesim::devices::deviceModelFor(
             file.vendor.id, *entry.productCode, device->profileNo, driveObjects)) ==
-        slavesim::devices::DeviceModelKind::kNone) {
+            slavesim::devices::DeviceModelKind::kNone &&
+        (options.model || !counters())) {
       return at(entry, "Param given, but this device has no model of ecsim with parameters" +
                            std::string(entry.model == "none" ? " (model=\"none\")" : ""));
     }

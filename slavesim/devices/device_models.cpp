@@ -105,11 +105,12 @@ DeviceModelKind deviceModelFor(std::uint32_t vendorId, std::uint32_t productCode
 
 std::optional<DeviceModelKind> deviceModelByName(std::string_view name) {
   if (name == "cia402") return DeviceModelKind::kCia402Drive;
+  if (name == "encoder") return DeviceModelKind::kEncoder;
   if (name == "none") return DeviceModelKind::kNone;
   return std::nullopt;
 }
 
-std::vector<std::string> deviceModelNames() { return {"cia402", "none"}; }
+std::vector<std::string> deviceModelNames() { return {"cia402", "encoder", "none"}; }
 
 unsigned cia402AxisCount(const coe::ObjectDictionary& od) {
   unsigned n = 0;
@@ -129,7 +130,8 @@ Status attachDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,
   device.setApplication(nullptr);  // the old model goes first (and saves its state)
   coe::ObjectDictionary& od = device.dictionary();
   if (!options.scripts.empty() && kind != DeviceModelKind::kDigitalInputs &&
-      kind != DeviceModelKind::kAnalogInputs && kind != DeviceModelKind::kSsiEncoder) {
+      kind != DeviceModelKind::kAnalogInputs && kind != DeviceModelKind::kSsiEncoder &&
+      kind != DeviceModelKind::kEncoder) {
     return makeError(ErrorCode::kInvalidArgument,
                      "input scripts (signal.N) need an input terminal or an encoder");
   }
@@ -172,6 +174,14 @@ Status attachDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,
       EncoderTerminalOptions encoder{drive.encoder, drive.initialShaftAngle, drive.stateFile,
                                      drive.stateSaveInterval};
       ECSIM_ASSIGN_OR_RETURN(auto terminal, SsiEncoderTerminal::create(od, encoder));
+      ECSIM_TRY(applyScripts(*terminal, options.scripts));
+      device.setApplication(std::move(terminal));
+      return okStatus();
+    }
+    case DeviceModelKind::kEncoder: {
+      EncoderTerminalOptions encoder{drive.encoder, drive.initialShaftAngle, drive.stateFile,
+                                     drive.stateSaveInterval};
+      ECSIM_ASSIGN_OR_RETURN(auto terminal, SsiEncoderTerminal::createForCounters(od, encoder));
       ECSIM_TRY(applyScripts(*terminal, options.scripts));
       device.setApplication(std::move(terminal));
       return okStatus();

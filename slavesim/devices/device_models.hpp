@@ -15,8 +15,10 @@
 // controlword 0x6040 and statusword 0x6041 (a device of another profile, e.g. 5001 MDP, may use
 // 0x6040 for something else). The drive binds to the device's own objects and PDO entries; a
 // device with further axes (0x6840/0x6841, 0x7040/0x7041, ...) gets one drive per axis
-// (MultiAxisDrive). Other devices keep the plain ProcessDataDevice. A topology's
-// model="cia402|none" overrides the choice (DeviceModelKind by name: deviceModelByName).
+// (MultiAxisDrive). A device with no model so far whose TxPDOs carry counter values
+// (counterValueChannels, encoder_terminal.hpp) gets the encoder profile (kEncoder; its caller
+// asks, as that needs the dictionary). Other devices keep the plain ProcessDataDevice. A
+// topology's model="cia402|encoder|none" overrides the choice (deviceModelByName).
 #pragma once
 
 #include <cstdint>
@@ -46,6 +48,7 @@ enum class DeviceModelKind : std::uint8_t {
   kCia402Drive,
   kRobotDrive,
   kSsiEncoder,
+  kEncoder,  // counter values of any device (SsiEncoderTerminal::createForCounters)
 };
 
 // hasDriveObjects: the device's dictionary has 0x6040 and 0x6041.
