@@ -223,11 +223,16 @@ Result<TopologyConfig> parseEniTopology(const xml::Context& ctx, const Element* 
   auto built = topology::topologyFromEni(*eni, {esiFolder});
   if (!built.ok()) return ctx.error(eniElement, built.error().message());
   TopologyConfig cfg = std::move(built).value();
+  cfg.warnings = std::move(eni->warnings);
   std::vector<std::string_view> names;
   for (std::size_t i = 0; i < cfg.slaves.size(); ++i) {
     cfg.byName.emplace(cfg.slaves[i].name, i);
     names.push_back(cfg.slaves[i].name);
+    // Errors building it name this file (TopologyConfig::file): the line is the <Eni>'s, until
+    // a <Slave> below names it.
+    cfg.slaves[i].line = eniElement->GetLineNum();
   }
+  for (auto& link : cfg.links) link.line = eniElement->GetLineNum();
   std::map<std::size_t, int> given;  // ENI slave -> line of its <Slave>
   for (const Element* e : xml::Children(root, "Slave")) {
     ECSIM_TRY(xml::checkNames(ctx, e, kEniSlaveNames));

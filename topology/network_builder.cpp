@@ -255,6 +255,7 @@ Result<Network> buildNetwork(const TopologyConfig& config) {
     }
     net.cables.push_back({link.name, link.toSlave, link.toPort});
   }
+  net.warnings.insert(net.warnings.end(), config.warnings.begin(), config.warnings.end());
   net.warnings.insert(net.warnings.end(), factory.warnings().begin(), factory.warnings().end());
   return net;
 }

@@ -96,6 +96,23 @@ TEST_F(EniMachine, ATopologyOnTheEniAddsOnlyBehaviour) {
   EXPECT_EQ(dev::deviceModelOf(segment.slave(3)), nullptr) << "Axis2: model=\"none\"";
 }
 
+// What the ENI reader ignores with a warning (here a cycle time out of range) reaches the
+// network's warnings through the topology too, as through `ecsim serve ENI`.
+TEST_F(EniMachine, TheEnisWarningsBecomeTheNetworks) {
+  ECSIM_REQUIRE_SHARED(sharedDir() / "esi" / "ingenia_esi.xml");
+  std::string text = kMachineEni;
+  text.insert(text.find("</Config>"), "<Cyclic><CycleTime>5000000</CycleTime></Cyclic>\n");
+  std::ofstream(dir_ / "machine.xml") << text;
+  auto config = loadTopologyFile(topology(""));
+  ASSERT_TRUE(config.ok()) << config.error().message();
+  auto network = topology::buildNetwork(*config);
+  ASSERT_TRUE(network.ok()) << network.error().message();
+  ASSERT_FALSE(network->warnings.empty());
+  EXPECT_NE(network->warnings[0].find("machine.xml, line 8: CycleTime 5000000 us"),
+            std::string::npos)
+      << network->warnings[0];
+}
+
 TEST_F(EniMachine, MistakesNameTheTopologyLineAndTheClosestName) {
   ECSIM_REQUIRE_SHARED(sharedDir() / "esi" / "ingenia_esi.xml");
   struct Case {
