@@ -7,6 +7,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "config/eni.hpp"
+#include "config/eni_topology.hpp"
 #include "config/xml_util.hpp"
 #include "protocol/closest_name.hpp"
 #include "protocol/read_file.hpp"
@@ -69,7 +71,11 @@ Result<std::optional<std::int64_t>> attrInteger(const xml::Context& ctx, const E
 constexpr std::string_view kCableWhy = " m (the 100BASE-TX segment limit)";
 
 // What each element takes (docs/topology.md); anything else is an error (xml::checkNames).
-const xml::Names kTopologyNames{{"name"}, {"Master", "Slave", "Link"}, {"Master"}};
+const xml::Names kTopologyNames{{"name"}, {"Master", "Slave", "Link", "Eni"}, {"Master", "Eni"}};
+// <Eni file= esiDir=>: the slaves and wiring of an ENI; its <Slave> elements name ENI slaves and
+// carry only behaviour (model, parameters, inputs, state file).
+const xml::Names kEniNames{{"file", "esiDir"}};
+const xml::Names kEniSlaveNames{{"name", "model", "stateFile"}, {"Input", "Param"}};
 const xml::Names kMasterNames{{"cable"}};
 const xml::Names kSlaveNames{{"name", "esi", "product", "revision", "device", "eeprom", "esc",
                               "dc", "processingDelayNs", "forwardingDelayNs", "stateFile",
@@ -77,12 +83,56 @@ const xml::Names kSlaveNames{{"name", "esi", "product", "revision", "device", "e
                              {"Clock", "Input", "Param", "Module"},
                              {"Clock"}};
 // <Slave model="...">: the device models a topology may choose (docs/devices.md).
-const std::vector<std::string_view> kModelNames{"cia402", "io", "analog", "loopback", "none"};
+const std::vector<std::string_view> kModelNames{"cia402", "io", "analog", "encoder", "loopback", "none"};
 const xml::Names kClockNames{{"offsetNs", "driftPpm"}};
 const xml::Names kInputNames{{"entry", "value"}};
 const xml::Names kParamNames{{"name", "value"}};
 const xml::Names kModuleNames{{"type", "ident"}};
 const xml::Names kLinkNames{{"name", "from", "to", "cable"}};
+
+// A <Slave>'s <Input> and <Param> children.
+Status parseInputsAndParams(const xml::Context& ctx, const Element* e, TopologySlave& s) {
+  for (const Element* in : xml::Children(e, "Input")) {
+    TopologyInput input;
+    input.line = in->GetLineNum();
+    ECSIM_TRY(xml::checkNames(ctx, in, kInputNames));
+    const char* entry = in->Attribute("entry");
+    if (entry == nullptr) return ctx.error(in, "Input needs entry=\"INDEX:SUB\"");
+    std::string_view text(entry);
+    auto colon = text.find(':');
+    if (colon == std::string_view::npos) return ctx.error(in, "entry must be INDEX:SUB");
+    ECSIM_ASSIGN_OR_RETURN(input.index, xml::parseNumber<std::uint16_t>(ctx, in, "entry index",
+                                                                        text.substr(0, colon)));
+    ECSIM_ASSIGN_OR_RETURN(input.subIndex, xml::parseNumber<std::uint8_t>(ctx, in, "entry subindex",
+                                                                          text.substr(colon + 1)));
+    ECSIM_ASSIGN_OR_RETURN(auto value, xml::attrNumber<std::int64_t>(ctx, in, "value"));
+    if (!value) return ctx.error(in, "Input needs a value");
+    input.value = *value;
+    s.inputs.push_back(input);
+  }
+  for (const Element* param : xml::Children(e, "Param")) {
+    ECSIM_TRY(xml::checkNames(ctx, param, kParamNames));
+    const char* pname = param->Attribute("name");
+    const char* value = param->Attribute("value");
+    if (pname == nullptr || value == nullptr) {
+      return ctx.error(param, "Param needs name and value attributes");
+    }
+    s.params.push_back({pname, value, param->GetLineNum()});
+  }
+  return okStatus();
+}
+
+// model="NAME" of a <Slave>, one of kModelNames.
+Status parseModel(const xml::Context& ctx, const Element* e, TopologySlave& s) {
+  const char* model = e->Attribute("model");
+  if (model == nullptr) return okStatus();
+  if (std::find(kModelNames.begin(), kModelNames.end(), std::string_view(model)) ==
+      kModelNames.end()) {
+    return ctx.error(e, unknownNameText("model", model, kModelNames, " on <Slave>"));
+  }
+  s.model = model;
+  return okStatus();
+}
 
 Result<TopologySlave> parseSlave(const xml::Context& ctx, const Element* e,
                                  const std::filesystem::path& folder) {
@@ -129,44 +179,12 @@ Result<TopologySlave> parseSlave(const xml::Context& ctx, const Element* e,
         s.driftPpm, attrDouble(ctx, clock, "driftPpm", 0.0, -kMaxDriftPpm, kMaxDriftPpm, " ppm"));
   }
   if (const char* state = e->Attribute("stateFile")) s.stateFile = folder / state;
-  if (const char* model = e->Attribute("model")) {
-    if (std::find(kModelNames.begin(), kModelNames.end(), std::string_view(model)) ==
-        kModelNames.end()) {
-      return ctx.error(e, unknownNameText("model", model, kModelNames, " on <Slave>"));
-    }
-    if (s.esiFile.empty()) {
-      return ctx.error(e, "Slave '" + s.name + "': model= needs a device from an ESI file (esi=)");
-    }
-    s.model = model;
+  ECSIM_TRY(parseModel(ctx, e, s));
+  if (!s.model.empty() && s.esiFile.empty()) {
+    return ctx.error(e, "Slave '" + s.name + "': model= needs a device from an ESI file (esi=)");
   }
   s.folder = folder;
-  for (const Element* in : xml::Children(e, "Input")) {
-    TopologyInput input;
-    input.line = in->GetLineNum();
-    ECSIM_TRY(xml::checkNames(ctx, in, kInputNames));
-    const char* entry = in->Attribute("entry");
-    if (entry == nullptr) return ctx.error(in, "Input needs entry=\"INDEX:SUB\"");
-    std::string_view text(entry);
-    auto colon = text.find(':');
-    if (colon == std::string_view::npos) return ctx.error(in, "entry must be INDEX:SUB");
-    ECSIM_ASSIGN_OR_RETURN(input.index, xml::parseNumber<std::uint16_t>(ctx, in, "entry index",
-                                                                        text.substr(0, colon)));
-    ECSIM_ASSIGN_OR_RETURN(input.subIndex, xml::parseNumber<std::uint8_t>(ctx, in, "entry subindex",
-                                                                          text.substr(colon + 1)));
-    ECSIM_ASSIGN_OR_RETURN(auto value, xml::attrNumber<std::int64_t>(ctx, in, "value"));
-    if (!value) return ctx.error(in, "Input needs a value");
-    input.value = *value;
-    s.inputs.push_back(input);
-  }
-  for (const Element* param : xml::Children(e, "Param")) {
-    ECSIM_TRY(xml::checkNames(ctx, param, kParamNames));
-    const char* pname = param->Attribute("name");
-    const char* value = param->Attribute("value");
-    if (pname == nullptr || value == nullptr) {
-      return ctx.error(param, "Param needs name and value attributes");
-    }
-    s.params.push_back({pname, value, param->GetLineNum()});
-  }
+  ECSIM_TRY(parseInputsAndParams(ctx, e, s));
   if (const char* moduleFile = e->Attribute("modules")) s.moduleFile = folder / moduleFile;
   for (const Element* m : xml::Children(e, "Module")) {
     TopologyModule module;
@@ -183,6 +201,60 @@ Result<TopologySlave> parseSlave(const xml::Context& ctx, const Element* e,
     return ctx.error(e, "Slave '" + s.name + "': modules need a device from an ESI file (esi=)");
   }
   return s;
+}
+
+// A topology on an ENI (<Eni file= esiDir=>): the ENI's slaves and wiring (topologyFromEni),
+// then each <Slave name=> adds behaviour to the ENI slave of that name.
+Result<TopologyConfig> parseEniTopology(const xml::Context& ctx, const Element* root,
+                                        const Element* eniElement,
+                                        const std::filesystem::path& folder) {
+  ECSIM_TRY(xml::checkNames(ctx, eniElement, kEniNames));
+  const char* eniName = eniElement->Attribute("file");
+  if (eniName == nullptr || *eniName == 0) return ctx.error(eniElement, "Eni needs file=\"ENI.xml\"");
+  if (const Element* link = root->FirstChildElement("Link")) {
+    return ctx.error(link, "a topology on an <Eni> takes its wiring from the ENI: no <Link>");
+  }
+  const std::filesystem::path eniFile = folder / eniName;
+  const char* esiDir = eniElement->Attribute("esiDir");
+  const std::filesystem::path esiFolder = esiDir != nullptr ? folder / esiDir
+                                                            : eniFile.parent_path();
+  auto eni = loadEniFile(eniFile);
+  if (!eni.ok()) return ctx.error(eniElement, eni.error().message());
+  auto built = topology::topologyFromEni(*eni, {esiFolder});
+  if (!built.ok()) return ctx.error(eniElement, built.error().message());
+  TopologyConfig cfg = std::move(built).value();
+  cfg.warnings = std::move(eni->warnings);
+  std::vector<std::string_view> names;
+  for (std::size_t i = 0; i < cfg.slaves.size(); ++i) {
+    cfg.byName.emplace(cfg.slaves[i].name, i);
+    names.push_back(cfg.slaves[i].name);
+    // Errors building it name this file (TopologyConfig::file): the line is the <Eni>'s, until
+    // a <Slave> below names it.
+    cfg.slaves[i].line = eniElement->GetLineNum();
+  }
+  for (auto& link : cfg.links) link.line = eniElement->GetLineNum();
+  std::map<std::size_t, int> given;  // ENI slave -> line of its <Slave>
+  for (const Element* e : xml::Children(root, "Slave")) {
+    ECSIM_TRY(xml::checkNames(ctx, e, kEniSlaveNames));
+    const char* name = e->Attribute("name");
+    if (name == nullptr || *name == 0) return ctx.error(e, "Slave needs a name attribute");
+    const auto found = cfg.byName.find(std::string_view(name));
+    if (found == cfg.byName.end()) {
+      return ctx.error(e, unknownNameText("slave", name, names,
+                                          " in " + eniFile.filename().string()));
+    }
+    if (auto [it, fresh] = given.emplace(found->second, e->GetLineNum()); !fresh) {
+      return ctx.error(e, fmt::format("slave '{}' given twice (first on line {})", name,
+                                      it->second));
+    }
+    TopologySlave& s = cfg.slaves[found->second];
+    ECSIM_TRY(parseModel(ctx, e, s));
+    if (const char* state = e->Attribute("stateFile")) s.stateFile = folder / state;
+    ECSIM_TRY(parseInputsAndParams(ctx, e, s));
+    s.folder = folder;
+    s.line = e->GetLineNum();
+  }
+  return cfg;
 }
 
 // Before anything runs: every cable has a name of its own ("master" is the master's), and every
@@ -259,6 +331,13 @@ Result<TopologyConfig> parseTopology(std::string_view text, const std::filesyste
     ECSIM_TRY(xml::checkNames(ctx, master, kMasterNames));
     ECSIM_ASSIGN_OR_RETURN(cfg.masterCableMetres,
                            attrDouble(ctx, master, "cable", 1.0, 0, kMaxCableMetres, kCableWhy));
+  }
+  if (const Element* eniElement = root->FirstChildElement("Eni")) {
+    ECSIM_ASSIGN_OR_RETURN(TopologyConfig onEni, parseEniTopology(ctx, root, eniElement, folder));
+    onEni.file = file;
+    onEni.name = cfg.name.empty() ? onEni.name : cfg.name;
+    onEni.masterCableMetres = cfg.masterCableMetres;
+    return onEni;
   }
   for (const Element* e : xml::Children(root, "Slave")) {
     if (cfg.slaves.size() == kMaxSlaves) {

@@ -94,6 +94,9 @@ struct TopologyConfig {
   // Slave index by name, filled by parseTopology (findSlave falls back to a search when a
   // caller filled `slaves` itself).
   std::map<std::string, std::size_t, std::less<>> byName;
+  // What reading found without refusing (an ENI's ignored values, for a topology on an ENI),
+  // one line each naming file and line; buildNetwork passes them on as the network's warnings.
+  std::vector<std::string> warnings;
 
   std::optional<std::size_t> findSlave(std::string_view name) const;
 };

@@ -72,6 +72,8 @@ class Reader {
  public:
   explicit Reader(std::string file) : file_(std::move(file)), ctx_(file_) {}
   const xml::Context& context() const { return ctx_; }
+  // The scenario's folder: relative files of its actions are found there.
+  std::filesystem::path folder() const { return std::filesystem::path(file_).parent_path(); }
 
   Error error(const XMLElement* e, const std::string& what) const { return ctx_.error(e, what); }
   std::string where(const XMLElement* e) const {
@@ -183,7 +185,8 @@ Result<TimedAction> readAction(const Reader& r, const XMLElement* e, SimTime cyc
   }
   // Every argument now, not when the timeline reaches the action.
   ECSIM_ASSIGN_OR_RETURN(a.fault,
-                         topology::parseFault(a.action, {topology::FaultScope::kScenario, cycleTime}));
+                         topology::parseFault(a.action, {topology::FaultScope::kScenario, cycleTime,
+                                                         r.folder()}));
   return a;
 }
 

@@ -117,7 +117,10 @@ Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiDevice& device, std::st
         sii.identity.vendorId, sii.identity.productCode, device.profileNo, driveObjects));
     if (!options.model && kind == devices::DeviceModelKind::kNone &&
         sii.identity.vendorId != kEcsimVendorId) {
-      kind = devices::chooseIoProfile(*od, device.profileNo);  // a vendor's IO device
+      // A vendor's device: an encoder when its TxPDOs carry counter values, else IO.
+      kind = !devices::counterValueChannels(*od).empty()
+                 ? devices::DeviceModelKind::kEncoder
+                 : devices::chooseIoProfile(*od, device.profileNo);
     }
     ECSIM_TRY(devices::attachDeviceModel(*pd, kind, modelOptions));
     // A power cycle re-creates the model as built here (plus what outlives the power).

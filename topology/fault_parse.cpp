@@ -393,7 +393,7 @@ Result<Fault> parseFault(const FaultAction& a, const FaultContext& context) {
     f.slave = slave;
     ECSIM_ASSIGN_OR_RETURN(auto channel, a.number("channel", 1, kMaxFaultChannel));
     ECSIM_ASSIGN_OR_RETURN(auto text, a.require("signal"));
-    auto signal = slavesim::devices::parseSignal(text);
+    auto signal = slavesim::devices::parseSignal(text, context.baseDir);
     if (!signal.ok()) return a.error(signal.error().context);
     f.channel = static_cast<unsigned>(channel);
     f.text = std::string(text);

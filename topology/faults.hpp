@@ -51,6 +51,7 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <map>
 #include <optional>
 #include <set>
@@ -223,6 +224,9 @@ using Fault = std::variant<LinkDown, LinkUp, Loss, Corrupt, Delay, PowerOff, Pow
 struct FaultContext {
   FaultScope scope{FaultScope::kControl};
   SimTime cycleTime{0};
+  // Where a relative file of an argument (`signal="csv file=trace.csv"`) is: a scenario's
+  // folder; empty (the working directory) for a control line.
+  std::filesystem::path baseDir{};
 };
 // Checks and converts every argument (checkFaultArguments, the ranges above, names of states
 // and kinds with the closest valid one, the input signal's text); errors begin with the

@@ -12,6 +12,7 @@
 #include "protocol/closest_name.hpp"
 #include "protocol/read_file.hpp"
 #include "protocol/sii.hpp"
+#include "slavesim/coe/od_from_esi.hpp"
 #include "slavesim/devices/device_params.hpp"
 #include "slavesim/esi_slave.hpp"
 #include "slavesim/generic_slave.hpp"
@@ -325,6 +326,7 @@ Result<Network> buildNetwork(const TopologyConfig& config) {
     }
     net.cables.push_back({link.name, link.toSlave, link.toPort});
   }
+  net.warnings.insert(net.warnings.end(), config.warnings.begin(), config.warnings.end());
   net.warnings.insert(net.warnings.end(), factory.warnings().begin(), factory.warnings().end());
   return net;
 }

@@ -3,22 +3,18 @@
 // code and revision among the ESI files of a search path (every *.xml in the folders given;
 // an exact revision first, else the highest revision of that product), wired by the ENI's
 // PreviousPort entries (a tree) or, without them, as a line in ENI order. The result is a
-// topology description (config/topology_file.hpp) built with buildNetwork.
+// topology description (topologyFromEni, config/eni_topology.hpp) built with buildNetwork.
 #pragma once
 
 #include <filesystem>
 #include <vector>
 
 #include "config/eni.hpp"
+#include "config/eni_topology.hpp"
 #include "config/topology_file.hpp"
 #include "topology/network_builder.hpp"
 
 namespace ecsim::topology {
-
-// The topology an ENI describes; errors name the ENI file and line of the slave whose device
-// no ESI file of `esiDirs` has.
-Result<TopologyConfig> topologyFromEni(const EniConfig& eni,
-                                       const std::vector<std::filesystem::path>& esiDirs);
 
 // loadEniFile + topologyFromEni + buildNetwork.
 Result<Network> buildNetworkFromEni(const std::filesystem::path& eniFile,

@@ -116,12 +116,13 @@ std::optional<DeviceModelKind> deviceModelByName(std::string_view name) {
   if (name == "io") return DeviceModelKind::kIo;
   if (name == "analog") return DeviceModelKind::kAnalog;
   if (name == "loopback") return DeviceModelKind::kLoopback;
+  if (name == "encoder") return DeviceModelKind::kEncoder;
   if (name == "none") return DeviceModelKind::kNone;
   return std::nullopt;
 }
 
 std::vector<std::string> deviceModelNames() {
-  return {"cia402", "io", "analog", "loopback", "none"};
+  return {"cia402", "io", "analog", "encoder", "loopback", "none"};
 }
 
 unsigned cia402AxisCount(const coe::ObjectDictionary& od) {
@@ -144,7 +145,7 @@ Status attachDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,
   if (!options.scripts.empty() && kind != DeviceModelKind::kDigitalInputs &&
       kind != DeviceModelKind::kAnalogInputs && kind != DeviceModelKind::kSsiEncoder &&
       kind != DeviceModelKind::kIo && kind != DeviceModelKind::kAnalog &&
-      kind != DeviceModelKind::kLoopback) {
+      kind != DeviceModelKind::kLoopback && kind != DeviceModelKind::kEncoder) {
     return makeError(ErrorCode::kInvalidArgument,
                      "input scripts (signal.N) need an input terminal or an encoder");
   }
@@ -212,6 +213,14 @@ Status attachDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,
       EncoderTerminalOptions encoder{drive.encoder, drive.initialShaftAngle, drive.stateFile,
                                      drive.stateSaveInterval};
       ECSIM_ASSIGN_OR_RETURN(auto terminal, SsiEncoderTerminal::create(od, encoder));
+      ECSIM_TRY(applyScripts(*terminal, options.scripts));
+      device.setApplication(std::move(terminal));
+      return okStatus();
+    }
+    case DeviceModelKind::kEncoder: {
+      EncoderTerminalOptions encoder{drive.encoder, drive.initialShaftAngle, drive.stateFile,
+                                     drive.stateSaveInterval};
+      ECSIM_ASSIGN_OR_RETURN(auto terminal, SsiEncoderTerminal::createForCounters(od, encoder));
       ECSIM_TRY(applyScripts(*terminal, options.scripts));
       device.setApplication(std::move(terminal));
       return okStatus();

@@ -15,10 +15,12 @@
 // controlword 0x6040 and statusword 0x6041 (a device of another profile, e.g. 5001 MDP, may use
 // 0x6040 for something else). The drive binds to the device's own objects and PDO entries; a
 // device with further axes (0x6840/0x6841, 0x7040/0x7041, ...) gets one drive per axis
-// (MultiAxisDrive). Any other device whose ESI gives no profile or MDP 5001 gets the analog
-// profile when its PDOs map analog values, the io profile when they map digital entries
-// (io_profile.hpp, chooseIoProfile); the rest keep the plain ProcessDataDevice. A topology's
-// model="cia402|io|analog|loopback|none" overrides the choice (deviceModelByName).
+// (MultiAxisDrive). Any other device gets the encoder profile when its TxPDOs carry counter
+// values (counterValueChannels, encoder_terminal.hpp), else, when its ESI gives no profile or
+// MDP 5001, the analog profile when its PDOs map analog values and the io profile when they
+// map digital entries (io_profile.hpp, chooseIoProfile); the rest keep the plain
+// ProcessDataDevice. A topology's model="cia402|io|analog|encoder|loopback|none" overrides the
+// choice (deviceModelByName).
 #pragma once
 
 #include <cstdint>
@@ -52,6 +54,7 @@ enum class DeviceModelKind : std::uint8_t {
   kIo,        // io_profile.hpp: digital inputs and outputs of the device's own PDO entries
   kAnalog,    // analog inputs and outputs of the device's own PDO entries
   kLoopback,  // io, inputs following another slave's outputs (loopback.from)
+  kEncoder,  // counter values of any device (SsiEncoderTerminal::createForCounters)
 };
 
 // hasDriveObjects: the device's dictionary has 0x6040 and 0x6041.

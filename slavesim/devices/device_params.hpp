@@ -10,7 +10,8 @@
 //   axis.*     substepHz, idealCurrentLoop (0/1)
 //   encoder.*  kind (incremental, single-turn, multi-turn), resolution (counts per turn),
 //              multiTurnBits, quantisation (counts), noise (counts, standard deviation), seed;
-//              a drive's encoder, or each channel's of an encoder terminal (ECS5001), whose
+//              a drive's encoder, or each channel's of an encoder terminal (ECS5001, the
+//              encoder profile of any counter terminal: count = turns * resolution), whose
 //              shaft starts at drive.initialShaftAngle and may be scripted by signal.N (turns)
 //   drive.*    followingErrorWindow (counts, 0x6065), followingErrorTimeout (ms, 0x6066),
 //              torqueLimit (per mille of rated torque, 0x6072), quickStopDeceleration

@@ -31,6 +31,16 @@
 //
 // The inputs are latched at each firmware step, or at SYNC0 while the ESC generates it: one new
 // reading (and one toggle) per point in simulation time.
+//
+// The `encoder` profile for third-party counter terminals (issue #17: Beckhoff EL5101/EL5151 of
+// the 2006 Beckhoff_EtherCAT_Terminals.xml, EJ5101 of Beckhoff_EJ5xxx.xml, ...) is the same
+// terminal bound by createForCounters to the counter values its TxPDOs carry
+// (counterValueChannels): channel n drives the n-th entry named "Counter value" (MDP 5001,
+// 0x6000 + 0x10 * k : 0x11) and the n-th entry named "Value" of an unsigned type (the compact
+// "Status, Value" PDOs: 0x3101:02 of the 2006 files, the EJ5101's 0x6000:02; the analog
+// terminals' "Value" is INT and does not count). Of the status bits it sets only the channel
+// object's "TxPDO State" (:0F) and "TxPDO Toggle" (:10), where entries of those names exist: the
+// SSI bits :01-:03 mean other things in a counter terminal (latch valid, set counter done).
 #pragma once
 
 #include <cstdint>
@@ -73,6 +83,10 @@ class SsiEncoderTerminal final : public Application {
   // is none, kParse when the state file is not one.
   static Result<std::unique_ptr<SsiEncoderTerminal>> create(
       coe::ObjectDictionary& od, const EncoderTerminalOptions& options = {});
+  // The encoder profile: one channel per counter value (counterValueChannels); kNotFound when
+  // the TxPDOs carry none.
+  static Result<std::unique_ptr<SsiEncoderTerminal>> createForCounters(
+      coe::ObjectDictionary& od, const EncoderTerminalOptions& options = {});
   ~SsiEncoderTerminal() override;
   SsiEncoderTerminal(const SsiEncoderTerminal&) = delete;
   SsiEncoderTerminal& operator=(const SsiEncoderTerminal&) = delete;
@@ -106,12 +120,17 @@ class SsiEncoderTerminal final : public Application {
     explicit Channel(const EncoderParams& p) : encoder(p) {}
     Encoder encoder;
     ObjectRef dataError, frameError, powerFailure, txPdoState, txPdoToggle, counter;
+    ObjectRef compactCounter;  // the same count in a compact "Value" entry (EJ5101 0x6000:02)
     std::optional<Signal> script;
     double angle{0.0};
+    std::uint32_t reported{0};  // the counter value of the last reading
     std::uint8_t faults{encoder_fault::kNone};
     bool toggle{false};
   };
   explicit SsiEncoderTerminal(const EncoderTerminalOptions& options) : options_(options) {}
+  // The shaft angle at power-up (state file, else the options'); opens the state file.
+  Result<double> powerUpAngle();
+  Channel& addChannel(double angle);
   void latch(SimTime now);
 
   EncoderTerminalOptions options_;
@@ -122,5 +141,18 @@ class SsiEncoderTerminal final : public Application {
   std::optional<PeriodicStateSaver> stateSaver_;
   bool latched_{false};
 };
+
+// A counter value a TxPDO mapping object (0x1A00-0x1BFF) of `od` maps.
+struct CounterEntry {
+  std::uint16_t index{0};
+  std::uint8_t subindex{0};
+};
+// The counter channels of a dictionary (the encoder profile's rule above): per channel, its
+// "Counter value" entry and its compact "Value" entry, either absent (index 0). Empty when the
+// TxPDOs map no counter value.
+struct CounterChannel {
+  CounterEntry counter, compact;
+};
+std::vector<CounterChannel> counterValueChannels(const coe::ObjectDictionary& od);
 
 }  // namespace ecsim::slavesim::devices

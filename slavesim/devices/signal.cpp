@@ -41,12 +41,46 @@ bool parseDouble(std::string_view s, double& out) {
   return ec == std::errc() && ptr == end && std::isfinite(out);
 }
 
+// splitmix64's finaliser (Steele, Lea, Flood, "Fast splittable pseudorandom number generators",
+// OOPSLA 2014): a bijective mix of a 64-bit counter, the hash of a counter-based generator.
+std::uint64_t mix64(std::uint64_t x) {
+  x += 0x9E3779B97F4A7C15ULL;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
+  return x ^ (x >> 31);
+}
+
+// The top 53 bits of a hash as a double in [0, 1).
+double unitInterval(std::uint64_t h) {
+  constexpr double kTwoToMinus53 = 1.0 / 9007199254740992.0;
+  return static_cast<double>(h >> 11) * kTwoToMinus53;
+}
+
 }  // namespace
 
 Signal Signal::constant(double value) {
   Signal s;
   s.kind_ = Kind::kConstant;
   s.a_ = value;
+  return s;
+}
+
+Signal Signal::step(double at, double before, double after) {
+  Signal s;
+  s.kind_ = Kind::kStep;
+  s.a_ = before;
+  s.b_ = after;
+  s.c_ = at;
+  return s;
+}
+
+Signal Signal::noise(double mean, double sigma, std::uint64_t seed, double period) {
+  Signal s;
+  s.kind_ = Kind::kNoise;
+  s.a_ = mean;
+  s.b_ = sigma;
+  s.seed_ = seed;
+  s.period_ = period;
   return s;
 }
 
@@ -147,11 +181,28 @@ double Signal::tableValue(double t) const {
   return a.value + (b.value - a.value) * (t - a.time) / (b.time - a.time);
 }
 
+double Signal::noiseValue(SimTime elapsed) const {
+  // Sample k counted in whole nanoseconds: t / period in doubles puts t = k periods now and
+  // then just below k (1 ms / 0.001).
+  const auto periodNs = static_cast<SimTime>(std::llround(period_ * kNsPerSecond));
+  if (periodNs <= 0) return a_;
+  const auto k = static_cast<std::uint64_t>(elapsed / periodNs);
+  // Sample k's two uniform numbers: the hash of (seed, 2k) and of (seed, 2k + 1).
+  const std::uint64_t stream = mix64(seed_);
+  const double u1 = 1.0 - unitInterval(mix64(stream ^ (2 * k)));  // (0, 1]: log(u1) finite
+  const double u2 = unitInterval(mix64(stream ^ (2 * k + 1)));
+  // Box-Muller: sqrt(-2 ln u1) cos(2 pi u2) is a standard normal deviate.
+  const double z = std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
+  return a_ + b_ * z;
+}
+
 double Signal::value(SimTime t) const {
   const double s = seconds(saturatingSub(t, origin_));
   switch (kind_) {
     case Kind::kConstant:
       return a_;
+    case Kind::kStep:
+      return s < c_ ? a_ : b_;
     case Kind::kSquare:
       if (period_ <= 0.0) return a_;
       return phaseOf(s - d_, period_) < c_ ? b_ : a_;
@@ -161,6 +212,8 @@ double Signal::value(SimTime t) const {
       const double x = period_ > 0.0 ? phaseOf(s, period_) * period_ : s;
       return std::clamp(a_ + b_ * x, c_, d_);
     }
+    case Kind::kNoise:
+      return noiseValue(saturatingSub(t, origin_));
     case Kind::kTable:
       return tableValue(s);
     case Kind::kOutput:
@@ -189,7 +242,9 @@ Result<Signal> parseSignal(std::string_view text, const std::filesystem::path& b
     args[std::string(item.substr(0, eq))] = std::string(item.substr(eq + 1));
   }
   std::string problem;
+  std::vector<std::string_view> known;  // the kind's parameters, for the closest to a misspelt one
   auto num = [&](const char* name, double fallback) {
+    known.emplace_back(name);
     auto it = args.find(name);
     if (it == args.end()) return fallback;
     double v = 0.0;
@@ -200,6 +255,22 @@ Result<Signal> parseSignal(std::string_view text, const std::filesystem::path& b
   Signal out;
   if (kind == "constant") {
     out = Signal::constant(num("value", 0.0));
+  } else if (kind == "step") {
+    const double at = num("at", 0.0);
+    const double before = num("before", 0.0);
+    out = Signal::step(at, before, num("after", 1.0));
+  } else if (kind == "noise") {
+    constexpr double kMaxSeed = 9007199254740992.0;  // 2^53: every integer below is exact
+    const double mean = num("mean", 0.0);
+    const double sigma = num("sigma", 1.0);
+    const double seed = num("seed", 0.0);
+    const double period = num("period", 0.001);
+    out = Signal::noise(mean, sigma, static_cast<std::uint64_t>(seed >= 0.0 ? seed : 0.0), period);
+    if (problem.empty() && sigma < 0.0) problem = "sigma must be >= 0";
+    if (problem.empty() && !(period * kNsPerSecond >= 1.0)) problem = "period must be >= 1e-9";
+    if (problem.empty() && (seed < 0.0 || seed >= kMaxSeed || seed != std::floor(seed))) {
+      problem = "seed must be an integer in [0, 2^53)";
+    }
   } else if (kind == "square") {
     const double period = num("period", 1.0);
     const double low = num("low", 0.0);
@@ -224,6 +295,7 @@ Result<Signal> parseSignal(std::string_view text, const std::filesystem::path& b
     if (file == args.end()) {
       return makeError(ErrorCode::kParse, "signal \"" + std::string(text) + "\": csv needs file=");
     }
+    known.emplace_back("file");
     std::filesystem::path path = file->second;
     args.erase(file);
     if (path.is_relative() && !baseDir.empty()) path = baseDir / path;
@@ -231,6 +303,7 @@ Result<Signal> parseSignal(std::string_view text, const std::filesystem::path& b
     const bool step = num("step", 0.0) != 0.0;
     if (problem.empty() && args.empty()) return Signal::fromCsv(path, loop, step);
   } else if (kind == "output") {
+    known.emplace_back("slave");
     auto slave = args.find("slave");
     const double channel = num("channel", 0.0);
     if (slave == args.end() || slave->second.empty() || channel < 1 || channel > 255 ||
@@ -243,10 +316,13 @@ Result<Signal> parseSignal(std::string_view text, const std::filesystem::path& b
   } else {
     return makeError(ErrorCode::kParse,
                      "signal \"" + std::string(text) + "\": unknown kind '" + kind +
-                         "' (constant, square, sine, ramp, csv, output or a number)" +
-                         didYouMean(kind, {"constant", "square", "sine", "ramp", "csv", "output"}));
+                         "' (constant, step, square, sine, ramp, noise, csv, output or a number)" +
+                         didYouMean(kind, {"constant", "step", "square", "sine", "ramp", "noise",
+                                           "csv", "output"}));
   }
-  if (problem.empty() && !args.empty()) problem = "unknown parameter '" + args.begin()->first + "'";
+  if (problem.empty() && !args.empty()) {
+    problem = unknownNameText("parameter", args.begin()->first, known, " of " + kind);
+  }
   if (!problem.empty()) {
     return makeError(ErrorCode::kParse, "signal \"" + std::string(text) + "\": " + problem);
   }

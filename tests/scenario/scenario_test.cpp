@@ -1,6 +1,7 @@
 // The scenario format (errors name file and line), the runner on the demo network, and the
 // determinism a CI system relies on: the same scenario and seed give the same report and pcap.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -64,6 +65,25 @@ TEST(ScenarioFile, TimesInMillisecondsOrCycles) {
   EXPECT_EQ(s->expectations[1].afterCycle, 60u);
   EXPECT_FALSE(s->expectations[1].afterTime) << "ours counts cycles";
   EXPECT_EQ(s->expectations[1].within, 25 * kNsPerMs);
+}
+
+// A CSV file of an input action is found beside the scenario, as a topology's CSV files are
+// beside the topology (docs/scenarios.md), not in the directory ecsim runs in.
+TEST(ScenarioFile, InputCsvFilesAreFoundBesideTheScenario) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("ecsim_scenario_csv_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "trace.csv") << "0,0\n1,10\n";
+  auto s = parseScenario(
+      wrap("<Timeline>\n"
+           "  <Action cycle=\"5\" do=\"input\" slave=\"DI1\" channel=\"1\" "
+           "signal=\"csv file=trace.csv\"/>\n"
+           "</Timeline>\n<Expect>\n  <State slave=\"DI1\" state=\"OP\"/>\n</Expect>\n"),
+      dir / "s.xml");
+  std::filesystem::remove_all(dir);
+  ASSERT_TRUE(s.ok()) << s.error().message();
+  const auto& input = std::get<topology::Input>(s->actions[0].fault);
+  EXPECT_DOUBLE_EQ(input.signal.value(kNsPerSecond / 2), 5.0);
 }
 
 TEST(ScenarioFile, ErrorsNameFileAndLine) {
