@@ -19,6 +19,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <string_view>
 
 namespace ecsim::slavesim::devices::cia402 {
@@ -112,6 +113,17 @@ enum class Mode : std::int8_t {
 // The 0x6502 bit of a mode of operation (0 for modes with no bit, e.g. manufacturer modes).
 std::uint32_t supportedModeBit(std::int8_t mode);
 std::string_view toString(Mode mode);
+// The modes of operation ecsim's drive models, as 0x6502 bits: PP, PV, HM, CSP, CSV, CST (not
+// VL 2, TQ 4, IP 7, nor the manufacturer-specific negative modes).
+inline constexpr std::uint32_t kModelledModes = 0x3A5;
+// The modes a drive runs, as 0x6502 bits: those its 0x6502 (`supported`) lists that ecsim
+// models. A 0x6502 of 0 (a placeholder of SOES-generated ESIs) or none counts as "all".
+std::uint32_t runnableModes(std::optional<std::uint64_t> supported);
+// Whether the mode can be set at power-up on a drive that runs `runnable` (0x6502 bits): one
+// of them, or 0 (no mode: the drive holds still until a master chooses one).
+bool startsIn(std::int8_t mode, std::uint32_t runnable);
+// "0 (no mode), 1 (PP), 8 (CSP)": mode 0 and the modes of `modes` (0x6502 bits), for messages.
+std::string describeModes(std::uint32_t modes);
 
 // ---- state machine ----------------------------------------------------------------------------
 enum class State : std::uint8_t {

@@ -361,11 +361,9 @@ void Cia402Drive::injectFault(std::uint16_t code) {
 }
 
 void Cia402Drive::switchMode(std::int8_t requested) {
-  constexpr std::uint32_t kImplemented = 0x3A5;  // PP, PV, HM, CSP, CSV, CST
-  auto listed = static_cast<std::uint32_t>(obj_.supportedModes.getUnsigned(kImplemented));
-  if (listed == 0) listed = kImplemented;  // a placeholder 0 (SOES ESIs) states nothing
-  const std::uint32_t supported = listed & kImplemented;
-  if ((cia402::supportedModeBit(requested) & supported) == 0) return;  // refused: keep the mode
+  const std::uint32_t runnable = cia402::runnableModes(
+      obj_.supportedModes ? std::optional(obj_.supportedModes.getUnsigned()) : std::nullopt);
+  if ((cia402::supportedModeBit(requested) & runnable) == 0) return;  // refused: keep the mode
   mode_ = requested;
   startMode();
 }
