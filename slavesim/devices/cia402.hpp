@@ -44,6 +44,13 @@ inline constexpr std::uint16_t kTorqueActualValue = 0x6077;
 inline constexpr std::uint16_t kTargetPosition = 0x607A;
 inline constexpr std::uint16_t kSoftwarePositionLimit = 0x607D;  // :01 min, :02 max
 inline constexpr std::uint16_t kMaxMotorSpeed = 0x6080;          // rpm
+// Factor group (:01 numerator, :02 denominator each): position encoder resolution (encoder
+// increments : motor revolutions), gear ratio (motor revolutions : driving shaft revolutions),
+// feed constant (feed : driving shaft revolutions), and the older position factor.
+inline constexpr std::uint16_t kPositionEncoderResolution = 0x608F;
+inline constexpr std::uint16_t kGearRatio = 0x6091;
+inline constexpr std::uint16_t kFeedConstant = 0x6092;
+inline constexpr std::uint16_t kPositionFactor = 0x6093;
 inline constexpr std::uint16_t kProfileVelocity = 0x6081;
 inline constexpr std::uint16_t kProfileAcceleration = 0x6083;
 inline constexpr std::uint16_t kProfileDeceleration = 0x6084;

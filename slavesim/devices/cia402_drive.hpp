@@ -44,6 +44,17 @@
 //    active. The fault reaction stops at the quick-stop deceleration (at most
 //    faultReactionTimeout), then the power stage goes off.
 //  - transitions 5, 8 and 9 switch the power stage off at once (the motor coasts).
+//  - units (CiA 402 factor group, IEC 61800-7-201): position [increments] = position [user
+//    units] * position factor, position factor = 0x608F (increments / motor revolutions) *
+//    0x6091 (motor / shaft revolutions) / 0x6092 (feed / shaft revolutions); a device with none
+//    of the three and a 0x6093 position factor (numerator / denominator) takes that. Absent
+//    objects and zero terms count as 1, so the default unit is one encoder increment. The
+//    positions (0x607A, 0x6064, 0x60F4, 0x6065, 0x607D) are in user units, velocities (0x60FF,
+//    0x606C, 0x6081, 0x6099) in user units/s and accelerations (0x6083, 0x6084, 0x609A) in user
+//    units/s^2; the factor is re-read every cycle, so an SDO write takes effect at once (while
+//    powered, the mode restarts from the actual position). A 0x608F whose ratio is a whole
+//    number other than 1 gives the encoder's counts per revolution at creation, unless
+//    DriveParams::resolutionFromDictionary is false (encoder.resolution given).
 //  - position is the encoder count plus the home offset; 0x6064 wraps at 32 bits. The shaft
 //    angle is kept in DriveParams::stateFile (read at creation; written when the power stage
 //    goes off, on AL state changes, by saveState(), when the drive is destroyed, and every
@@ -98,6 +109,9 @@ struct DriveParams {
   // a fixed-mode CSP device (0x6502 lists no mode, the RxPDOs map 0x607A but not 0x6060, as
   // the SOES CiA 402 example STMBL_ECAT): CSP.
   std::optional<std::int8_t> initialMode;
+  // A 0x608F position encoder resolution (increments : revolutions, a whole ratio other than
+  // 1) sets encoder.countsPerRevolution at creation.
+  bool resolutionFromDictionary{true};
 };
 
 // Where a drive's emergency messages go (the slave's CoE server, coe::CoeServer::pushEmergency).
@@ -123,6 +137,8 @@ class Cia402Drive : public Application {
   double position() const { return measured_; }
   double demandPosition() const { return demand_; }
   double velocity() const;  // counts/s
+  // Encoder counts per position user unit (the CiA 402 position factor; 1 by default).
+  double positionFactor() const { return countsPerUnit_; }
   bool homeSwitch() const;
   bool homingAttained() const { return homingAttained_; }
 
@@ -180,6 +196,8 @@ class Cia402Drive : public Application {
   double torqueLimitNm() const;
   double velocityLimitCounts() const;
   SimTime interpolationPeriod() const;
+  double readPositionFactor() const;
+  void updatePositionFactor();
   // ---- cia402_modes.cpp ----
   void startMode();
   void latchModeInputs(std::uint16_t controlword, std::uint16_t previous);
@@ -212,6 +230,8 @@ class Cia402Drive : public Application {
     ObjectRef profileVelocity, profileAcceleration, profileDeceleration;
     ObjectRef homingMethod, homingSpeedSwitch, homingSpeedZero, homingAcceleration;
     ObjectRef ipValue, ipIndex, feActual, targetVelocity, supportedModes, errorRegister;
+    ObjectRef encoderIncrements, encoderRevolutions, gearMotor, gearShaft, feed, feedRevolutions;
+    ObjectRef factorNumerator, factorDenominator;
   } obj_;
   EmergencySink emergencySink_;
   std::uint64_t emergenciesSent_{0};
@@ -240,6 +260,7 @@ class Cia402Drive : public Application {
   bool followingError_{false};
   std::optional<SimTime> feSince_;
   double countsToRad_{0.0};
+  double countsPerUnit_{1.0};  // the position factor
 
   // mode state
   MotionProfile profile_;

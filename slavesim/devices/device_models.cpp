@@ -167,6 +167,7 @@ Status attachDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,
   // vendor's 0x2011 is the vendor's (the Ingenia EVS-NET-01's is a status word).
   const auto vendor = od.get<std::uint32_t>(coe::kIdentityIndex, kIdentityVendorSub);
   const bool ecsimResolution = vendor.ok() && *vendor == kEcsimVendorId;
+  drive.resolutionFromDictionary = !options.encoderResolutionSet;  // else 0x608F may set it
   if (options.encoderResolutionSet) {
     if (ecsimResolution && od.findEntry(kEncoderResolution, 0) != nullptr) {
       ECSIM_TRY(od.set<std::uint32_t>(kEncoderResolution, 0, drive.encoder.countsPerRevolution));

@@ -7,13 +7,13 @@
 // allowed.
 #include <gtest/gtest.h>
 
-#include <cstring>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 
 #include "slavesim/devices/device_models.hpp"
+#include "tests/slavesim/esi_variant.hpp"
 #include "tests/slavesim/one_slave_topology.hpp"
 
 namespace ecsim::testing {
@@ -58,21 +58,12 @@ class DriveModeParam : public OneSlaveTopology, public ::testing::WithParamInter
  protected:
   // examples/esi/ecsim_devices.xml with the ECS7201's 0x6502 default replaced, in dir_.
   std::filesystem::path esiWith(std::uint32_t supported) {
-    std::ifstream in(examplesEsiPath());
-    std::stringstream text;
-    text << in.rdbuf();
-    std::string esi = text.str();
-    const std::string standard = "<DefaultValue>#x000003A5</DefaultValue>";
     char replacement[64];
     std::snprintf(replacement, sizeof replacement, "<DefaultValue>#x%08X</DefaultValue>",
                   supported);
-    for (auto at = esi.find(standard); at != std::string::npos;
-         at = esi.find(standard, at + std::strlen(replacement))) {
-      esi.replace(at, standard.size(), replacement);
-    }
-    const auto path = dir_ / "drives.xml";
-    std::ofstream(path) << esi;
-    return path;
+    return writeEcs7201Variant(
+        dir_ / "drives.xml",
+        {"", "", {{"<DefaultValue>#x000003A5</DefaultValue>", replacement}}});
   }
 };
 
