@@ -59,6 +59,7 @@ inline constexpr std::uint16_t kHomingSpeeds = 0x6099;  // :01 switch search, :0
 inline constexpr std::uint16_t kHomingAcceleration = 0x609A;
 inline constexpr std::uint16_t kInterpolationTimePeriod = 0x60C2;  // :01 value, :02 index
 inline constexpr std::uint16_t kFollowingErrorActualValue = 0x60F4;
+inline constexpr std::uint16_t kDigitalInputs = 0x60FD;
 inline constexpr std::uint16_t kTargetVelocity = 0x60FF;
 inline constexpr std::uint16_t kSupportedDriveModes = 0x6502;
 }  // namespace obj
@@ -75,6 +76,13 @@ inline constexpr std::uint16_t kErrorReset = 0x0000;          // emergency: erro
 // (bit 3), 0x81xx communication (bit 4), other 0x6xxx-0x8xxx device profile (bit 5). 0 for
 // kErrorReset.
 std::uint8_t errorRegisterFor(std::uint16_t code);
+
+// Digital inputs 0x60FD (bits 3-15 reserved, 16-31 manufacturer-specific).
+namespace di {
+inline constexpr std::uint32_t kNegativeLimitSwitch = 1u << 0;
+inline constexpr std::uint32_t kPositiveLimitSwitch = 1u << 1;
+inline constexpr std::uint32_t kHomeSwitch = 1u << 2;
+}  // namespace di
 
 // ---- controlword and statusword bits ------------------------------------------------------------
 namespace cw {

@@ -123,6 +123,7 @@ Status Cia402Drive::init() {
   obj_.feedRevolutions = ref(kFeedConstant, 2);
   obj_.factorNumerator = ref(kPositionFactor, 1);
   obj_.factorDenominator = ref(kPositionFactor, 2);
+  obj_.digitalInputs = ref(kDigitalInputs);
   if (params_.resolutionFromDictionary) {
     const std::uint64_t increments = obj_.encoderIncrements.getUnsigned(0);
     const std::uint64_t revolutions = obj_.encoderRevolutions.getUnsigned(0);
@@ -183,6 +184,18 @@ double Cia402Drive::velocity() const {
 bool Cia402Drive::homeSwitch() const {
   return params_.homeSwitchCounts &&
          static_cast<double>(reading_.counts) >= *params_.homeSwitchCounts;
+}
+
+std::uint32_t Cia402Drive::digitalInputs() const {
+  const auto count = static_cast<double>(reading_.counts);
+  std::uint32_t bits = homeSwitch() ? cia402::di::kHomeSwitch : 0u;
+  if (params_.negativeLimitSwitchCounts && count <= *params_.negativeLimitSwitchCounts) {
+    bits |= cia402::di::kNegativeLimitSwitch;
+  }
+  if (params_.positiveLimitSwitchCounts && count >= *params_.positiveLimitSwitchCounts) {
+    bits |= cia402::di::kPositiveLimitSwitch;
+  }
+  return bits;
 }
 
 double Cia402Drive::torqueLimitNm() const {
@@ -423,6 +436,7 @@ void Cia402Drive::publish(SimTime now) {
   obj_.torqueActual.set(std::llround(axis_.torque() / params_.motor.ratedTorque * 1000.0));
   obj_.feActual.set(std::llround(followingErrorValue_ / countsPerUnit_));
   obj_.errorCode.set(errorCode_);
+  obj_.digitalInputs.set(digitalInputs());
   publishExtra(now);
 }
 

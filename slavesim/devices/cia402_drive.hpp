@@ -55,6 +55,8 @@
 //    powered, the mode restarts from the actual position). A 0x608F whose ratio is a whole
 //    number other than 1 gives the encoder's counts per revolution at creation, unless
 //    DriveParams::resolutionFromDictionary is false (encoder.resolution given).
+//  - digital inputs 0x60FD: bit 0 negative and bit 1 positive limit switch, bit 2 home switch,
+//    from the encoder count against DriveParams' switch positions (bits 16-31 stay 0).
 //  - position is the encoder count plus the home offset; 0x6064 wraps at 32 bits. The shaft
 //    angle is kept in DriveParams::stateFile (read at creation; written when the power stage
 //    goes off, on AL state changes, by saveState(), when the drive is destroyed, and every
@@ -91,6 +93,11 @@ struct DriveParams {
   std::int64_t homeOffset{0};           // counts: the position the home point gets
   // Home switch: active while the encoder count (before any home offset) is >= this.
   std::optional<double> homeSwitchCounts{0.0};
+  // Hardware limit switches: the negative one active while the encoder count (before any home
+  // offset) is <= its position, the positive one while it is >=; unset: none. Shown in 0x60FD
+  // with the home switch; the drive itself does not react to them.
+  std::optional<double> negativeLimitSwitchCounts;
+  std::optional<double> positiveLimitSwitchCounts;
   SimTime initTime{0};                           // in Not ready to switch on
   SimTime faultReactionTimeout{500 * kNsPerMs};  // longest fault reaction
   double initialShaftAngle{0.0};                 // rad, when there is no state file yet
@@ -140,6 +147,8 @@ class Cia402Drive : public Application {
   // Encoder counts per position user unit (the CiA 402 position factor; 1 by default).
   double positionFactor() const { return countsPerUnit_; }
   bool homeSwitch() const;
+  // The digital inputs 0x60FD shows (cia402::di bits).
+  std::uint32_t digitalInputs() const;
   bool homingAttained() const { return homingAttained_; }
 
   ServoAxis& axis() { return axis_; }
@@ -231,7 +240,7 @@ class Cia402Drive : public Application {
     ObjectRef homingMethod, homingSpeedSwitch, homingSpeedZero, homingAcceleration;
     ObjectRef ipValue, ipIndex, feActual, targetVelocity, supportedModes, errorRegister;
     ObjectRef encoderIncrements, encoderRevolutions, gearMotor, gearShaft, feed, feedRevolutions;
-    ObjectRef factorNumerator, factorDenominator;
+    ObjectRef factorNumerator, factorDenominator, digitalInputs;
   } obj_;
   EmergencySink emergencySink_;
   std::uint64_t emergenciesSent_{0};

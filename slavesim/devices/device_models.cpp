@@ -395,6 +395,25 @@ Result<bool> applyPlain(DeviceModelOptions& o, const DeviceParam& p) {
     }
     o.drive.initialMode = mode;
     o.driveModeLine = p.line;
+  } else if (n == "drive.homeSwitch" || n == "drive.negativeLimitSwitch" ||
+             n == "drive.positiveLimitSwitch") {
+    std::optional<double>& target = n == "drive.homeSwitch" ? o.drive.homeSwitchCounts
+                                    : n == "drive.negativeLimitSwitch"
+                                        ? o.drive.negativeLimitSwitchCounts
+                                        : o.drive.positiveLimitSwitchCounts;
+    if (p.value == "none") {
+      target.reset();
+    } else {
+      ECSIM_ASSIGN_OR_RETURN(auto counts, integer<std::int64_t>(p, -(1ll << 52), 1ll << 52));
+      target = static_cast<double>(counts);
+    }
+    const auto& lo = o.drive.negativeLimitSwitchCounts;
+    const auto& hi = o.drive.positiveLimitSwitchCounts;
+    if (lo && hi && *lo >= *hi) {
+      return paramError(p, "the negative limit switch must be below the positive one (" +
+                               std::to_string(static_cast<long long>(*lo)) + " >= " +
+                               std::to_string(static_cast<long long>(*hi)) + ")");
+    }
   } else if (n == "drive.homeOffset") {
     ECSIM_ASSIGN_OR_RETURN(o.drive.homeOffset, integer<std::int64_t>(p, -(1ll << 52), 1ll << 52));
   } else if (n == "drive.initTimeMs") {
