@@ -124,6 +124,7 @@ Status Cia402Drive::init() {
   obj_.factorNumerator = ref(kPositionFactor, 1);
   obj_.factorDenominator = ref(kPositionFactor, 2);
   obj_.digitalInputs = ref(kDigitalInputs);
+  touchProbe_.bind(od_, at);
   if (params_.resolutionFromDictionary) {
     const std::uint64_t increments = obj_.encoderIncrements.getUnsigned(0);
     const std::uint64_t revolutions = obj_.encoderRevolutions.getUnsigned(0);
@@ -299,7 +300,11 @@ void Cia402Drive::substep() {
   checkFollowingError(positionDemand_ && state_ == State::kOperationEnabled);
   if (encoder_.faulted()) raiseFault(cia402::kErrorEncoder);
   axis_.substep(command, encoder_.angleOf(static_cast<double>(reading_.counts)));
+  const bool switchBefore = homeSwitch();
+  const std::int64_t countsBefore = reading_.counts;
   measure();
+  touchProbe_.sense(switchBefore, homeSwitch(), params_.homeSwitchCounts.value_or(0.0),
+                    countsBefore, reading_.counts, encoder_.params().countsPerRevolution);
 }
 
 void Cia402Drive::checkFollowingError(bool active) {
@@ -333,6 +338,7 @@ void Cia402Drive::takeCommands(AlState al) {
     enterState(State::kSwitchOnDisabled);  // transition 1
   }
   updatePositionFactor();
+  touchProbe_.takeFunction();
   // The mode is a setting: it may be chosen by SDO before OP.
   const auto requested = static_cast<std::int8_t>(obj_.mode.get(mode_));
   if (requested != mode_) switchMode(requested);
@@ -437,6 +443,7 @@ void Cia402Drive::publish(SimTime now) {
   obj_.feActual.set(std::llround(followingErrorValue_ / countsPerUnit_));
   obj_.errorCode.set(errorCode_);
   obj_.digitalInputs.set(digitalInputs());
+  touchProbe_.publish(static_cast<double>(offset_), countsPerUnit_);
   publishExtra(now);
 }
 

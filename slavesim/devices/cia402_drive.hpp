@@ -57,6 +57,8 @@
 //    DriveParams::resolutionFromDictionary is false (encoder.resolution given).
 //  - digital inputs 0x60FD: bit 0 negative and bit 1 positive limit switch, bit 2 home switch,
 //    from the encoder count against DriveParams' switch positions (bits 16-31 stay 0).
+//  - touch probe 0x60B8-0x60BD where present (cia402_touch_probe.hpp): probe 1 latches at the
+//    edges of the home switch or at the encoder's zero impulse, probe 2 at the zero impulse.
 //  - position is the encoder count plus the home offset; 0x6064 wraps at 32 bits. The shaft
 //    angle is kept in DriveParams::stateFile (read at creation; written when the power stage
 //    goes off, on AL state changes, by saveState(), when the drive is destroyed, and every
@@ -72,6 +74,7 @@
 #include "protocol/coe.hpp"
 #include "protocol/result.hpp"
 #include "slavesim/devices/cia402.hpp"
+#include "slavesim/devices/cia402_touch_probe.hpp"
 #include "slavesim/devices/device_state.hpp"
 #include "slavesim/devices/encoder.hpp"
 #include "slavesim/devices/motion_profile.hpp"
@@ -155,6 +158,7 @@ class Cia402Drive : public Application {
   const ServoAxis& axis() const { return axis_; }
   Encoder& encoder() { return encoder_; }
   const Encoder& encoder() const { return encoder_; }
+  const TouchProbe& touchProbe() const { return touchProbe_; }
   const DriveParams& params() const { return params_; }
   // Raises a fault from outside (fault injection): fault reaction, then Fault with `code`
   // (e.g. cia402::kErrorOvercurrent, kErrorFollowing, kErrorEncoder), with its emergency.
@@ -242,6 +246,7 @@ class Cia402Drive : public Application {
     ObjectRef encoderIncrements, encoderRevolutions, gearMotor, gearShaft, feed, feedRevolutions;
     ObjectRef factorNumerator, factorDenominator, digitalInputs;
   } obj_;
+  TouchProbe touchProbe_;
   EmergencySink emergencySink_;
   std::uint64_t emergenciesSent_{0};
 
