@@ -1,5 +1,7 @@
 #include "slavesim/devices/cia402.hpp"
 
+#include <iterator>
+
 #include "slavesim/devices/error_register.hpp"
 
 namespace ecsim::slavesim::devices::cia402 {
@@ -28,6 +30,35 @@ std::uint32_t supportedModeBit(std::int8_t mode) {
     default:
       return 0;
   }
+}
+
+namespace {
+
+// Modes of operation 1..10 (CiA 402 / IEC 61800-7-201 object 0x6060) and their abbreviations;
+// 5 is reserved.
+constexpr std::string_view kModeAbbreviations[] = {"",   "PP", "VL",  "PV",  "TQ", "",
+                                                   "HM", "IP", "CSP", "CSV", "CST"};
+
+}  // namespace
+
+std::uint32_t runnableModes(std::optional<std::uint64_t> supported) {
+  if (!supported || *supported == 0) return kModelledModes;
+  return static_cast<std::uint32_t>(*supported) & kModelledModes;
+}
+
+bool startsIn(std::int8_t mode, std::uint32_t runnable) {
+  return mode == 0 || (supportedModeBit(mode) & runnable) != 0;
+}
+
+std::string describeModes(std::uint32_t modes) {
+  std::string text = "0 (no mode)";
+  for (std::int8_t mode = 1; mode < static_cast<std::int8_t>(std::size(kModeAbbreviations));
+       ++mode) {
+    if ((supportedModeBit(mode) & modes) == 0) continue;
+    text += ", " + std::to_string(mode) + " (" +
+            std::string(kModeAbbreviations[static_cast<std::size_t>(mode)]) + ")";
+  }
+  return text;
 }
 
 std::string_view toString(Mode mode) {

@@ -19,6 +19,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <string_view>
 
 namespace ecsim::slavesim::devices::cia402 {
@@ -43,6 +44,13 @@ inline constexpr std::uint16_t kTorqueActualValue = 0x6077;
 inline constexpr std::uint16_t kTargetPosition = 0x607A;
 inline constexpr std::uint16_t kSoftwarePositionLimit = 0x607D;  // :01 min, :02 max
 inline constexpr std::uint16_t kMaxMotorSpeed = 0x6080;          // rpm
+// Factor group (:01 numerator, :02 denominator each): position encoder resolution (encoder
+// increments : motor revolutions), gear ratio (motor revolutions : driving shaft revolutions),
+// feed constant (feed : driving shaft revolutions), and the older position factor.
+inline constexpr std::uint16_t kPositionEncoderResolution = 0x608F;
+inline constexpr std::uint16_t kGearRatio = 0x6091;
+inline constexpr std::uint16_t kFeedConstant = 0x6092;
+inline constexpr std::uint16_t kPositionFactor = 0x6093;
 inline constexpr std::uint16_t kProfileVelocity = 0x6081;
 inline constexpr std::uint16_t kProfileAcceleration = 0x6083;
 inline constexpr std::uint16_t kProfileDeceleration = 0x6084;
@@ -51,6 +59,7 @@ inline constexpr std::uint16_t kHomingSpeeds = 0x6099;  // :01 switch search, :0
 inline constexpr std::uint16_t kHomingAcceleration = 0x609A;
 inline constexpr std::uint16_t kInterpolationTimePeriod = 0x60C2;  // :01 value, :02 index
 inline constexpr std::uint16_t kFollowingErrorActualValue = 0x60F4;
+inline constexpr std::uint16_t kDigitalInputs = 0x60FD;
 inline constexpr std::uint16_t kTargetVelocity = 0x60FF;
 inline constexpr std::uint16_t kSupportedDriveModes = 0x6502;
 }  // namespace obj
@@ -67,6 +76,13 @@ inline constexpr std::uint16_t kErrorReset = 0x0000;          // emergency: erro
 // (bit 3), 0x81xx communication (bit 4), other 0x6xxx-0x8xxx device profile (bit 5). 0 for
 // kErrorReset.
 std::uint8_t errorRegisterFor(std::uint16_t code);
+
+// Digital inputs 0x60FD (bits 3-15 reserved, 16-31 manufacturer-specific).
+namespace di {
+inline constexpr std::uint32_t kNegativeLimitSwitch = 1u << 0;
+inline constexpr std::uint32_t kPositiveLimitSwitch = 1u << 1;
+inline constexpr std::uint32_t kHomeSwitch = 1u << 2;
+}  // namespace di
 
 // ---- controlword and statusword bits ------------------------------------------------------------
 namespace cw {
@@ -112,6 +128,17 @@ enum class Mode : std::int8_t {
 // The 0x6502 bit of a mode of operation (0 for modes with no bit, e.g. manufacturer modes).
 std::uint32_t supportedModeBit(std::int8_t mode);
 std::string_view toString(Mode mode);
+// The modes of operation ecsim's drive models, as 0x6502 bits: PP, PV, HM, CSP, CSV, CST (not
+// VL 2, TQ 4, IP 7, nor the manufacturer-specific negative modes).
+inline constexpr std::uint32_t kModelledModes = 0x3A5;
+// The modes a drive runs, as 0x6502 bits: those its 0x6502 (`supported`) lists that ecsim
+// models. A 0x6502 of 0 (a placeholder of SOES-generated ESIs) or none counts as "all".
+std::uint32_t runnableModes(std::optional<std::uint64_t> supported);
+// Whether the mode can be set at power-up on a drive that runs `runnable` (0x6502 bits): one
+// of them, or 0 (no mode: the drive holds still until a master chooses one).
+bool startsIn(std::int8_t mode, std::uint32_t runnable);
+// "0 (no mode), 1 (PP), 8 (CSP)": mode 0 and the modes of `modes` (0x6502 bits), for messages.
+std::string describeModes(std::uint32_t modes);
 
 // ---- state machine ----------------------------------------------------------------------------
 enum class State : std::uint8_t {

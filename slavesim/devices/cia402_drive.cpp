@@ -23,6 +23,7 @@ namespace {
 constexpr SimTime kMaxCatchUp = 10 * kNsPerSecond;
 constexpr std::uint64_t kFollowingErrorOff = 0xFFFFFFFFu;
 constexpr std::int64_t kDefaultMaxTorquePerMille = 3000;
+constexpr std::uint64_t kMaxEncoderResolution = 1u << 30;  // as encoder.resolution
 
 // ETG.6010 multi-axis layout: each further axis has its profile objects 0x800 higher.
 constexpr std::uint16_t kAxisIndexStep = 0x800;
@@ -114,6 +115,26 @@ Status Cia402Drive::init() {
   obj_.targetVelocity = target(kTargetVelocity, kVelocityDemandValue);
   obj_.supportedModes = ref(kSupportedDriveModes);
   obj_.errorRegister = ref(error_register::kIndex);
+  obj_.encoderIncrements = ref(kPositionEncoderResolution, 1);
+  obj_.encoderRevolutions = ref(kPositionEncoderResolution, 2);
+  obj_.gearMotor = ref(kGearRatio, 1);
+  obj_.gearShaft = ref(kGearRatio, 2);
+  obj_.feed = ref(kFeedConstant, 1);
+  obj_.feedRevolutions = ref(kFeedConstant, 2);
+  obj_.factorNumerator = ref(kPositionFactor, 1);
+  obj_.factorDenominator = ref(kPositionFactor, 2);
+  obj_.digitalInputs = ref(kDigitalInputs);
+  touchProbe_.bind(od_, at);
+  if (params_.resolutionFromDictionary) {
+    const std::uint64_t increments = obj_.encoderIncrements.getUnsigned(0);
+    const std::uint64_t revolutions = obj_.encoderRevolutions.getUnsigned(0);
+    if (increments > 0 && revolutions > 0 && increments != revolutions &&
+        increments % revolutions == 0 && increments / revolutions <= kMaxEncoderResolution) {
+      params_.encoder.countsPerRevolution = static_cast<std::uint32_t>(increments / revolutions);
+      encoder_ = Encoder(params_.encoder);
+    }
+  }
+  countsPerUnit_ = readPositionFactor();
   std::optional<std::int8_t> initialMode = params_.initialMode;
   if (!initialMode && obj_.supportedModes && obj_.supportedModes.getUnsigned() == 0 &&
       !rxPdoMaps(od_, at(kModesOfOperation)) && rxPdoMaps(od_, at(kTargetPosition))) {
@@ -166,6 +187,18 @@ bool Cia402Drive::homeSwitch() const {
          static_cast<double>(reading_.counts) >= *params_.homeSwitchCounts;
 }
 
+std::uint32_t Cia402Drive::digitalInputs() const {
+  const auto count = static_cast<double>(reading_.counts);
+  std::uint32_t bits = homeSwitch() ? cia402::di::kHomeSwitch : 0u;
+  if (params_.negativeLimitSwitchCounts && count <= *params_.negativeLimitSwitchCounts) {
+    bits |= cia402::di::kNegativeLimitSwitch;
+  }
+  if (params_.positiveLimitSwitchCounts && count >= *params_.positiveLimitSwitchCounts) {
+    bits |= cia402::di::kPositiveLimitSwitch;
+  }
+  return bits;
+}
+
 double Cia402Drive::torqueLimitNm() const {
   const auto perMille = static_cast<double>(obj_.maxTorque.get(kDefaultMaxTorquePerMille));
   return std::max(0.0, perMille) / 1000.0 * params_.motor.ratedTorque;
@@ -175,6 +208,27 @@ double Cia402Drive::velocityLimitCounts() const {
   const auto rpm = static_cast<double>(obj_.maxMotorSpeed.getUnsigned(0));
   if (rpm <= 0.0) return std::numeric_limits<double>::infinity();
   return rpm / 60.0 * encoder_.params().countsPerRevolution;
+}
+
+double Cia402Drive::readPositionFactor() const {
+  auto ratio = [](const ObjectRef& numerator, const ObjectRef& denominator) {
+    const std::uint64_t n = numerator.getUnsigned(0);
+    const std::uint64_t d = denominator.getUnsigned(0);
+    return n > 0 && d > 0 ? static_cast<double>(n) / static_cast<double>(d) : 1.0;
+  };
+  if (!obj_.encoderIncrements && !obj_.gearMotor && !obj_.feed) {
+    return ratio(obj_.factorNumerator, obj_.factorDenominator);
+  }
+  return ratio(obj_.encoderIncrements, obj_.encoderRevolutions) *
+         ratio(obj_.gearMotor, obj_.gearShaft) / ratio(obj_.feed, obj_.feedRevolutions);
+}
+
+void Cia402Drive::updatePositionFactor() {
+  const double factor = readPositionFactor();
+  if (factor == countsPerUnit_) return;
+  countsPerUnit_ = factor;
+  // The targets the master sent are in the old unit: start over from the actual position.
+  if (cia402::powered(state_)) startMode();
 }
 
 SimTime Cia402Drive::interpolationPeriod() const {
@@ -246,7 +300,11 @@ void Cia402Drive::substep() {
   checkFollowingError(positionDemand_ && state_ == State::kOperationEnabled);
   if (encoder_.faulted()) raiseFault(cia402::kErrorEncoder);
   axis_.substep(command, encoder_.angleOf(static_cast<double>(reading_.counts)));
+  const bool switchBefore = homeSwitch();
+  const std::int64_t countsBefore = reading_.counts;
   measure();
+  touchProbe_.sense(switchBefore, homeSwitch(), params_.homeSwitchCounts.value_or(0.0),
+                    countsBefore, reading_.counts, encoder_.params().countsPerRevolution);
 }
 
 void Cia402Drive::checkFollowingError(bool active) {
@@ -257,7 +315,7 @@ void Cia402Drive::checkFollowingError(bool active) {
     return;
   }
   const double error = std::abs(followingErrorValue_);
-  if (error <= static_cast<double>(window)) {
+  if (error <= static_cast<double>(window) * countsPerUnit_) {
     feSince_.reset();
     warning_ = false;
     return;
@@ -279,6 +337,8 @@ void Cia402Drive::takeCommands(AlState al) {
   if (state_ == State::kNotReadyToSwitchOn && lastNow_ >= readyAt_) {
     enterState(State::kSwitchOnDisabled);  // transition 1
   }
+  updatePositionFactor();
+  touchProbe_.takeFunction();
   // The mode is a setting: it may be chosen by SDO before OP.
   const auto requested = static_cast<std::int8_t>(obj_.mode.get(mode_));
   if (requested != mode_) switchMode(requested);
@@ -361,11 +421,9 @@ void Cia402Drive::injectFault(std::uint16_t code) {
 }
 
 void Cia402Drive::switchMode(std::int8_t requested) {
-  constexpr std::uint32_t kImplemented = 0x3A5;  // PP, PV, HM, CSP, CSV, CST
-  auto listed = static_cast<std::uint32_t>(obj_.supportedModes.getUnsigned(kImplemented));
-  if (listed == 0) listed = kImplemented;  // a placeholder 0 (SOES ESIs) states nothing
-  const std::uint32_t supported = listed & kImplemented;
-  if ((cia402::supportedModeBit(requested) & supported) == 0) return;  // refused: keep the mode
+  const std::uint32_t runnable = cia402::runnableModes(
+      obj_.supportedModes ? std::optional(obj_.supportedModes.getUnsigned()) : std::nullopt);
+  if ((cia402::supportedModeBit(requested) & runnable) == 0) return;  // refused: keep the mode
   mode_ = requested;
   startMode();
 }
@@ -378,11 +436,14 @@ void Cia402Drive::publish(SimTime now) {
   statusword_ = status;
   obj_.statusword.set(status);
   obj_.modeDisplay.set(mode_);
-  obj_.positionActual.set(wrap32(reading_.reported + offset_));
-  obj_.velocityActual.set(std::llround(velocity()));
+  obj_.positionActual.set(
+      wrap32(std::llround(static_cast<double>(reading_.reported + offset_) / countsPerUnit_)));
+  obj_.velocityActual.set(std::llround(velocity() / countsPerUnit_));
   obj_.torqueActual.set(std::llround(axis_.torque() / params_.motor.ratedTorque * 1000.0));
-  obj_.feActual.set(std::llround(followingErrorValue_));
+  obj_.feActual.set(std::llround(followingErrorValue_ / countsPerUnit_));
   obj_.errorCode.set(errorCode_);
+  obj_.digitalInputs.set(digitalInputs());
+  touchProbe_.publish(static_cast<double>(offset_), countsPerUnit_);
   publishExtra(now);
 }
 

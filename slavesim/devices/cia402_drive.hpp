@@ -44,6 +44,21 @@
 //    active. The fault reaction stops at the quick-stop deceleration (at most
 //    faultReactionTimeout), then the power stage goes off.
 //  - transitions 5, 8 and 9 switch the power stage off at once (the motor coasts).
+//  - units (CiA 402 factor group, IEC 61800-7-201): position [increments] = position [user
+//    units] * position factor, position factor = 0x608F (increments / motor revolutions) *
+//    0x6091 (motor / shaft revolutions) / 0x6092 (feed / shaft revolutions); a device with none
+//    of the three and a 0x6093 position factor (numerator / denominator) takes that. Absent
+//    objects and zero terms count as 1, so the default unit is one encoder increment. The
+//    positions (0x607A, 0x6064, 0x60F4, 0x6065, 0x607D) are in user units, velocities (0x60FF,
+//    0x606C, 0x6081, 0x6099) in user units/s and accelerations (0x6083, 0x6084, 0x609A) in user
+//    units/s^2; the factor is re-read every cycle, so an SDO write takes effect at once (while
+//    powered, the mode restarts from the actual position). A 0x608F whose ratio is a whole
+//    number other than 1 gives the encoder's counts per revolution at creation, unless
+//    DriveParams::resolutionFromDictionary is false (encoder.resolution given).
+//  - digital inputs 0x60FD: bit 0 negative and bit 1 positive limit switch, bit 2 home switch,
+//    from the encoder count against DriveParams' switch positions (bits 16-31 stay 0).
+//  - touch probe 0x60B8-0x60BD where present (cia402_touch_probe.hpp): probe 1 latches at the
+//    edges of the home switch or at the encoder's zero impulse, probe 2 at the zero impulse.
 //  - position is the encoder count plus the home offset; 0x6064 wraps at 32 bits. The shaft
 //    angle is kept in DriveParams::stateFile (read at creation; written when the power stage
 //    goes off, on AL state changes, by saveState(), when the drive is destroyed, and every
@@ -59,6 +74,7 @@
 #include "protocol/coe.hpp"
 #include "protocol/result.hpp"
 #include "slavesim/devices/cia402.hpp"
+#include "slavesim/devices/cia402_touch_probe.hpp"
 #include "slavesim/devices/device_state.hpp"
 #include "slavesim/devices/encoder.hpp"
 #include "slavesim/devices/motion_profile.hpp"
@@ -80,6 +96,11 @@ struct DriveParams {
   std::int64_t homeOffset{0};           // counts: the position the home point gets
   // Home switch: active while the encoder count (before any home offset) is >= this.
   std::optional<double> homeSwitchCounts{0.0};
+  // Hardware limit switches: the negative one active while the encoder count (before any home
+  // offset) is <= its position, the positive one while it is >=; unset: none. Shown in 0x60FD
+  // with the home switch; the drive itself does not react to them.
+  std::optional<double> negativeLimitSwitchCounts;
+  std::optional<double> positiveLimitSwitchCounts;
   SimTime initTime{0};                           // in Not ready to switch on
   SimTime faultReactionTimeout{500 * kNsPerMs};  // longest fault reaction
   double initialShaftAngle{0.0};                 // rad, when there is no state file yet
@@ -98,6 +119,9 @@ struct DriveParams {
   // a fixed-mode CSP device (0x6502 lists no mode, the RxPDOs map 0x607A but not 0x6060, as
   // the SOES CiA 402 example STMBL_ECAT): CSP.
   std::optional<std::int8_t> initialMode;
+  // A 0x608F position encoder resolution (increments : revolutions, a whole ratio other than
+  // 1) sets encoder.countsPerRevolution at creation.
+  bool resolutionFromDictionary{true};
 };
 
 // Where a drive's emergency messages go (the slave's CoE server, coe::CoeServer::pushEmergency).
@@ -123,13 +147,18 @@ class Cia402Drive : public Application {
   double position() const { return measured_; }
   double demandPosition() const { return demand_; }
   double velocity() const;  // counts/s
+  // Encoder counts per position user unit (the CiA 402 position factor; 1 by default).
+  double positionFactor() const { return countsPerUnit_; }
   bool homeSwitch() const;
+  // The digital inputs 0x60FD shows (cia402::di bits).
+  std::uint32_t digitalInputs() const;
   bool homingAttained() const { return homingAttained_; }
 
   ServoAxis& axis() { return axis_; }
   const ServoAxis& axis() const { return axis_; }
   Encoder& encoder() { return encoder_; }
   const Encoder& encoder() const { return encoder_; }
+  const TouchProbe& touchProbe() const { return touchProbe_; }
   const DriveParams& params() const { return params_; }
   // Raises a fault from outside (fault injection): fault reaction, then Fault with `code`
   // (e.g. cia402::kErrorOvercurrent, kErrorFollowing, kErrorEncoder), with its emergency.
@@ -180,6 +209,8 @@ class Cia402Drive : public Application {
   double torqueLimitNm() const;
   double velocityLimitCounts() const;
   SimTime interpolationPeriod() const;
+  double readPositionFactor() const;
+  void updatePositionFactor();
   // ---- cia402_modes.cpp ----
   void startMode();
   void latchModeInputs(std::uint16_t controlword, std::uint16_t previous);
@@ -212,7 +243,10 @@ class Cia402Drive : public Application {
     ObjectRef profileVelocity, profileAcceleration, profileDeceleration;
     ObjectRef homingMethod, homingSpeedSwitch, homingSpeedZero, homingAcceleration;
     ObjectRef ipValue, ipIndex, feActual, targetVelocity, supportedModes, errorRegister;
+    ObjectRef encoderIncrements, encoderRevolutions, gearMotor, gearShaft, feed, feedRevolutions;
+    ObjectRef factorNumerator, factorDenominator, digitalInputs;
   } obj_;
+  TouchProbe touchProbe_;
   EmergencySink emergencySink_;
   std::uint64_t emergenciesSent_{0};
 
@@ -240,6 +274,7 @@ class Cia402Drive : public Application {
   bool followingError_{false};
   std::optional<SimTime> feSince_;
   double countsToRad_{0.0};
+  double countsPerUnit_{1.0};  // the position factor
 
   // mode state
   MotionProfile profile_;

@@ -64,13 +64,13 @@ void Cia402Drive::latchModeInputs(std::uint16_t controlword, std::uint16_t previ
       // The 32-bit difference, so a target that wraps around moves the short way.
       const auto delta = static_cast<std::int32_t>(static_cast<std::uint32_t>(raw) -
                                                    static_cast<std::uint32_t>(cspLastRaw_));
-      cspEnd_ += delta;
+      cspEnd_ += static_cast<double>(delta) * countsPerUnit_;
       cspPeriod_ = interpolationPeriod();
       cspElapsed_ = 0;
       cspLastRaw_ = raw;
     }
   } else if (isMode(mode_, Mode::kCyclicSyncVelocity) || isMode(mode_, Mode::kProfileVelocity)) {
-    velocityTarget_ = static_cast<double>(obj_.targetVelocity.get());
+    velocityTarget_ = static_cast<double>(obj_.targetVelocity.get()) * countsPerUnit_;
   } else if (isMode(mode_, Mode::kCyclicSyncTorque)) {
     torqueTarget_ =
         static_cast<double>(obj_.targetTorque.get()) / 1000.0 * params_.motor.ratedTorque;
@@ -90,8 +90,8 @@ bool Cia402Drive::softwareLimits(double& min, double& max) const {
   constexpr std::int64_t kHighest = std::numeric_limits<std::int32_t>::max();
   const std::int64_t lo = obj_.limitMin.get(kLowest);
   const std::int64_t hi = obj_.limitMax.get(kHighest);
-  min = static_cast<double>(lo);
-  max = static_cast<double>(hi);
+  min = static_cast<double>(lo) * countsPerUnit_;
+  max = static_cast<double>(hi) * countsPerUnit_;
   // The whole DINT range (the default) and an empty range mean no limits.
   return lo < hi && (lo != kLowest || hi != kHighest);
 }
@@ -150,8 +150,10 @@ ServoCommand Cia402Drive::velocityCommand(double velocity, double acceleration) 
 ServoCommand Cia402Drive::operate() {
   const double h = seconds(axis_.substepNs());
   const double vmax = velocityLimitCounts();
-  const auto acc = static_cast<double>(obj_.profileAcceleration.getUnsigned(6553600));
-  const auto dec = static_cast<double>(obj_.profileDeceleration.getUnsigned(6553600));
+  const double acc =
+      static_cast<double>(obj_.profileAcceleration.getUnsigned(6553600)) * countsPerUnit_;
+  const double dec =
+      static_cast<double>(obj_.profileDeceleration.getUnsigned(6553600)) * countsPerUnit_;
   switch (static_cast<Mode>(mode_)) {
     case Mode::kCyclicSyncPosition: {
       const double fraction =
@@ -187,7 +189,8 @@ ServoCommand Cia402Drive::operate() {
       if (halt_) {
         profile_.toVelocity(0.0, acc, dec, h);
       } else if (ppMoving_) {
-        const auto speed = static_cast<double>(obj_.profileVelocity.getUnsigned(655360));
+        const double speed =
+            static_cast<double>(obj_.profileVelocity.getUnsigned(655360)) * countsPerUnit_;
         if (profile_.toPosition(ppTarget_, std::min(speed, vmax), acc, dec, h)) {
           ppMoving_ = false;
           if (ppBuffered_) {
@@ -219,7 +222,8 @@ ServoCommand Cia402Drive::stopping(bool faultReaction) {
   if (holding_) return positionCommand(demand_, 0.0);
   double deceleration = params_.quickStopDeceleration;
   if (option == 1 || option == 5) {
-    deceleration = static_cast<double>(obj_.profileDeceleration.getUnsigned(6553600));
+    deceleration =
+        static_cast<double>(obj_.profileDeceleration.getUnsigned(6553600)) * countsPerUnit_;
   } else if (option == 3 || option == 4 || option == 7 || option == 8) {
     // "At the current limit": the ramp the torque limit allows, with a margin for the loops.
     deceleration = kTorqueLimitRampShare * torqueLimitNm() / params_.motor.inertia / countsToRad_;
@@ -253,14 +257,15 @@ void Cia402Drive::startPpSetPoint(std::uint16_t controlword) {
   const auto raw = static_cast<std::int32_t>(obj_.targetPosition.get());
   double target = 0.0;
   if ((controlword & cw::kRelative) != 0) {
-    target = (ppMoving_ ? ppTarget_ : demand_) + raw;
+    target = (ppMoving_ ? ppTarget_ : demand_) + raw * countsPerUnit_;
   } else {
-    // The absolute target nearest the present position in 32-bit arithmetic.
+    // The absolute target nearest the present position in 32-bit arithmetic (user units).
+    const double hereUnits = std::round(measured_ / countsPerUnit_);
     const auto here = static_cast<std::int32_t>(
-        static_cast<std::uint32_t>(static_cast<std::uint64_t>(std::llround(measured_))));
+        static_cast<std::uint32_t>(static_cast<std::uint64_t>(std::llround(hereUnits))));
     const auto delta = static_cast<std::int32_t>(static_cast<std::uint32_t>(raw) -
                                                  static_cast<std::uint32_t>(here));
-    target = std::round(measured_) + delta;
+    target = (hereUnits + delta) * countsPerUnit_;
   }
   target = clampToLimits(target);
   internalLimit_ = false;
@@ -316,9 +321,12 @@ void Cia402Drive::setHome() {
 }
 
 void Cia402Drive::homingSubstep(double h) {
-  const auto fast = static_cast<double>(obj_.homingSpeedSwitch.getUnsigned(655360));
-  const auto slow = static_cast<double>(obj_.homingSpeedZero.getUnsigned(65536));
-  const auto acc = static_cast<double>(obj_.homingAcceleration.getUnsigned(6553600));
+  const double fast =
+      static_cast<double>(obj_.homingSpeedSwitch.getUnsigned(655360)) * countsPerUnit_;
+  const double slow =
+      static_cast<double>(obj_.homingSpeedZero.getUnsigned(65536)) * countsPerUnit_;
+  const double acc =
+      static_cast<double>(obj_.homingAcceleration.getUnsigned(6553600)) * countsPerUnit_;
   const bool on = homeSwitch();
   if (halt_ && homing_ != HomingPhase::kDone && homing_ != HomingPhase::kError) {
     homing_ = HomingPhase::kIdle;  // halt interrupts homing

@@ -1,6 +1,8 @@
 #include "slavesim/devices/device_models.hpp"
 
+#include <algorithm>
 #include <charconv>
+#include <cstdio>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -44,11 +46,37 @@ Status installDrive(ProcessDataDevice& device, Result<std::unique_ptr<T>> model,
   return okStatus();
 }
 
+// drive.mode against the supported drive modes 0x6502 of each axis (the parameter's value was
+// checked against the modes ecsim models when it was read).
+Status checkDriveMode(const coe::ObjectDictionary& od, const DriveParams& drive, int line,
+                      unsigned axes) {
+  if (!drive.initialMode) return okStatus();
+  for (unsigned n = 0; n < std::max(axes, 1u); ++n) {
+    const auto index = static_cast<std::uint16_t>(cia402::obj::kSupportedDriveModes +
+                                                  n * kAxisIndexStep);
+    const auto supported = od.get<std::uint32_t>(index, 0);
+    const std::uint32_t runnable =
+        cia402::runnableModes(supported.ok() ? std::optional<std::uint64_t>(*supported)
+                                             : std::nullopt);
+    if (cia402::startsIn(*drive.initialMode, runnable)) continue;
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "parameter 'drive.mode'%s = '%d': axis %u's supported drive modes 0x%04X = "
+                  "0x%08X do not list it; allowed: ",
+                  line > 0 ? (" on line " + std::to_string(line)).c_str() : "",
+                  static_cast<int>(*drive.initialMode), n, static_cast<unsigned>(index),
+                  static_cast<unsigned>(supported.ok() ? *supported : 0));
+    return makeError(ErrorCode::kInvalidArgument, text + cia402::describeModes(runnable));
+  }
+  return okStatus();
+}
+
 // One drive per axis of the dictionary: a Cia402Drive for one, a MultiAxisDrive for more.
 Status installDrives(ProcessDataDevice& device, const DriveParams& drive,
-                     const EmergencySink& emergencies) {
+                     const EmergencySink& emergencies, int modeLine) {
   coe::ObjectDictionary& od = device.dictionary();
   const unsigned count = cia402AxisCount(od);
+  ECSIM_TRY(checkDriveMode(od, drive, modeLine, count));
   if (count <= 1) return installDrive(device, Cia402Drive::create(od, drive), emergencies);
   std::vector<std::unique_ptr<Cia402Drive>> axes;
   for (unsigned n = 0; n < count; ++n) {
@@ -155,6 +183,7 @@ Status attachDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,
   // vendor's 0x2011 is the vendor's (the Ingenia EVS-NET-01's is a status word).
   const auto vendor = od.get<std::uint32_t>(coe::kIdentityIndex, kIdentityVendorSub);
   const bool ecsimResolution = vendor.ok() && *vendor == kEcsimVendorId;
+  drive.resolutionFromDictionary = !options.encoderResolutionSet;  // else 0x608F may set it
   if (options.encoderResolutionSet) {
     if (ecsimResolution && od.findEntry(kEncoderResolution, 0) != nullptr) {
       ECSIM_TRY(od.set<std::uint32_t>(kEncoderResolution, 0, drive.encoder.countsPerRevolution));
@@ -181,8 +210,9 @@ Status attachDeviceModel(ProcessDataDevice& device, DeviceModelKind kind,
       return okStatus();
     }
     case DeviceModelKind::kCia402Drive:
-      return installDrives(device, drive, options.emergencies);
+      return installDrives(device, drive, options.emergencies, options.driveModeLine);
     case DeviceModelKind::kRobotDrive:
+      ECSIM_TRY(checkDriveMode(od, drive, options.driveModeLine, 1));
       return installDrive(device, RobotDrive::create(od, drive), options.emergencies);
     case DeviceModelKind::kIo:
     case DeviceModelKind::kLoopback: {
@@ -409,7 +439,34 @@ Result<bool> applyPlain(DeviceModelOptions& o, const DeviceParam& p) {
   } else if (n == "drive.torqueLimit") {
     ECSIM_ASSIGN_OR_RETURN(o.drive.maxTorquePerMille, integer<std::uint16_t>(p, 0, 0xFFFF));
   } else if (n == "drive.mode") {
-    ECSIM_ASSIGN_OR_RETURN(o.drive.initialMode, integer<std::int8_t>(p, -128, 127));
+    // A CiA 402 mode ecsim models (or 0, no mode); the device's 0x6502 is checked where the
+    // model is attached (checkDriveMode).
+    ECSIM_ASSIGN_OR_RETURN(auto mode, integer<std::int8_t>(p, -128, 127));
+    if (!cia402::startsIn(mode, cia402::kModelledModes)) {
+      return paramError(p, "not a mode of operation ecsim's CiA 402 drive models; allowed: " +
+                               cia402::describeModes(cia402::kModelledModes));
+    }
+    o.drive.initialMode = mode;
+    o.driveModeLine = p.line;
+  } else if (n == "drive.homeSwitch" || n == "drive.negativeLimitSwitch" ||
+             n == "drive.positiveLimitSwitch") {
+    std::optional<double>& target = n == "drive.homeSwitch" ? o.drive.homeSwitchCounts
+                                    : n == "drive.negativeLimitSwitch"
+                                        ? o.drive.negativeLimitSwitchCounts
+                                        : o.drive.positiveLimitSwitchCounts;
+    if (p.value == "none") {
+      target.reset();
+    } else {
+      ECSIM_ASSIGN_OR_RETURN(auto counts, integer<std::int64_t>(p, -(1ll << 52), 1ll << 52));
+      target = static_cast<double>(counts);
+    }
+    const auto& lo = o.drive.negativeLimitSwitchCounts;
+    const auto& hi = o.drive.positiveLimitSwitchCounts;
+    if (lo && hi && *lo >= *hi) {
+      return paramError(p, "the negative limit switch must be below the positive one (" +
+                               std::to_string(static_cast<long long>(*lo)) + " >= " +
+                               std::to_string(static_cast<long long>(*hi)) + ")");
+    }
   } else if (n == "drive.homeOffset") {
     ECSIM_ASSIGN_OR_RETURN(o.drive.homeOffset, integer<std::int64_t>(p, -(1ll << 52), 1ll << 52));
   } else if (n == "drive.initTimeMs") {

@@ -86,6 +86,9 @@ struct DeviceModelOptions {
   // drive.encoder.countsPerRevolution was chosen (and goes into 0x2011); otherwise a
   // dictionary with 0x2011 gives it.
   bool encoderResolutionSet{false};
+  // The topology line of drive.mode (0: not from a file), for the error when the device's
+  // supported drive modes 0x6502 do not list it (checked by attachDeviceModel).
+  int driveModeLine{0};
   EmergencySink emergencies;  // drives: where their emergency messages go
   // Input terminals: scripted channels (1-based; digital on at >= 0.5, analog in volts,
   // encoder shaft in turns).

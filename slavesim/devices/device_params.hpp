@@ -13,10 +13,12 @@
 //              a drive's encoder, or each channel's of an encoder terminal (ECS5001, the
 //              encoder profile of any counter terminal: count = turns * resolution), whose
 //              shaft starts at drive.initialShaftAngle and may be scripted by signal.N (turns)
-//   drive.*    followingErrorWindow (counts, 0x6065), followingErrorTimeout (ms, 0x6066),
+//   drive.*    followingErrorWindow (user units, 0x6065), followingErrorTimeout (ms, 0x6066),
 //              torqueLimit (per mille of rated torque, 0x6072), quickStopDeceleration
 //              (counts/s^2), homeOffset (counts), initialShaftAngle (rad), mode (0x6060 at
-//              power-up, e.g. 8 for CSP), initTimeMs,
+//              power-up, e.g. 8 for CSP; a modelled mode the device's 0x6502 lists, or 0),
+//              homeSwitch, negativeLimitSwitch, positiveLimitSwitch (encoder counts before the
+//              home offset, or "none"; 0x60FD bits 2, 0, 1), initTimeMs,
 //              faultReactionTimeoutMs, stateSaveIntervalMs (simulated ms between saves of
 //              the stateFile while the shaft moves, default 100; 0: on state changes only)
 //   analog.*   fullScaleVolts, conversionPeriodUs
