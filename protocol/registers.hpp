@@ -265,6 +265,13 @@ inline constexpr Reg<std::uint64_t> kGeneralPurposeInputs{0x0F18, "General Purpo
 inline constexpr Block kUserRam{0x0F80, 128, "User RAM"};
 
 inline constexpr std::uint16_t kRegisterSpaceEnd = 0x1000;  // process RAM starts here
+// Where the digital I/O PDI writes the digital inputs: the first bytes of process RAM
+// (ESC datasheet section II, Digital I/O Input Data, 0x1000:0x1003).
+inline constexpr Block kDigitalIoInputData{0x1000, 4, "Digital I/O Input Data"};
+// PDI control 0x0140 values of the digital I/O PDI (section II 0x0140): 4 digital inputs,
+// 4 digital outputs, 2 of each, digital I/O.
+inline constexpr std::uint8_t kPdiFourDigitalInputs = 0x01;
+inline constexpr std::uint8_t kPdiDigitalIo = 0x04;
 
 // ---- bit fields -----------------------------------------------------------------------------
 namespace dl_status {  // 0x0110

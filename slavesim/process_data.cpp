@@ -32,8 +32,17 @@ bool inProcessRam(const Esc& esc, unsigned sm) {
 bool inDigitalOutputRegister(const Esc& esc, unsigned sm) {
   const Esc::SmConfig c = esc.smConfig(sm);
   constexpr std::uint32_t first = reg::kDigitalIoOutputData.address;
-  return c.start >= first && static_cast<std::uint32_t>(c.start) + c.length <=
-                                 first + sizeof(std::uint32_t);
+  return c.start >= first &&
+         static_cast<std::uint32_t>(c.start) + c.length <= first + sizeof(std::uint32_t);
+}
+
+// Digital input terminals served by the ESC's digital I/O PDI (PDI control 0x01-0x04; the
+// 2006-era EL1002/EL1004, whose ESI leaves their input SM at 0x1000 disabled, Enable="0", and
+// so SOEM leaves it): the ESC writes the inputs into process RAM 0x1000-0x1003 itself (section
+// II, Digital I/O Input Data), where the master's FMMU reads them with or without an SM.
+bool digitalInputPdi(const Esc& esc) {
+  const std::uint8_t pdi = esc.reg8(reg::kPdiControl.address);
+  return pdi >= reg::kPdiFourDigitalInputs && pdi <= reg::kPdiDigitalIo;
 }
 
 }  // namespace
@@ -123,7 +132,7 @@ void ProcessDataBinding::readOutputs(Esc& esc) {
     if (c.buffer != current) {
       current = c.buffer;
       src = esc.pdiOutputsReceived(b.sm) && inProcessRam(esc, b.sm) ? esc.pdiReadOutputs(b.sm)
-                                                                     : ConstBytes{};
+                                                                    : ConstBytes{};
       if (inDigitalOutputRegister(esc, b.sm)) {
         writeLe32(digitalOutputs, 0, esc.read(reg::kDigitalIoOutputData));
         const Esc::SmConfig sm = esc.smConfig(b.sm);
@@ -143,8 +152,13 @@ void ProcessDataBinding::writeInputs(Esc& esc) {
     coe::copyBits(b.bytes, c.bitOffset, ConstBytes(c.value, c.valueSize), 0, c.bits);
   }
   for (Buffer& b : buffers_) {
-    if (!b.outputs && !b.bytes.empty() && inProcessRam(esc, b.sm)) {
-      esc.pdiWriteInputs(b.sm, b.bytes);
+    if (b.outputs || b.bytes.empty()) continue;
+    if (inProcessRam(esc, b.sm) && esc.pdiWriteInputs(b.sm, b.bytes)) continue;
+    if (digitalInputPdi(esc) && b.bytes.size() <= reg::kDigitalIoInputData.width) {
+      // No SM buffer takes them: the digital I/O PDI writes the inputs to RAM itself.
+      for (std::size_t i = 0; i < b.bytes.size(); ++i) {
+        esc.pdiWrite8(static_cast<std::uint16_t>(reg::kDigitalIoInputData.address + i), b.bytes[i]);
+      }
     }
   }
 }
