@@ -26,6 +26,7 @@
 
 #include "embed/testing/network_fixture.hpp"
 #include "slavesim/devices/device_models.hpp"
+#include "support/cia402_steps.hpp"
 #include "support/test_network.hpp"
 
 namespace ecsim::testing {
@@ -128,13 +129,8 @@ TEST_P(VendorDrive, EnablesAndFollowsACspTurnThroughItsOwnPdos) {
   if (mode.ok()) mode->set<std::int8_t>(8);
 
   auto runUntil = [&](std::uint16_t cw, std::uint16_t mask, std::uint16_t want) {
-    controlword->set<std::uint16_t>(cw);
-    for (int i = 0; i < 50; ++i) {
-      target->set<std::int32_t>(actual->get<std::int32_t>());
-      if (!cycle().ok()) return false;
-      if ((statusword->get<std::uint16_t>() & mask) == want) return true;
-    }
-    return false;
+    return cia402RunUntil(
+        *controlword, *statusword, *target, *actual, [&] { return cycle(); }, cw, mask, want);
   };
   ASSERT_TRUE(runUntil(0x0000, 0x4F, 0x40))
       << "Switch on disabled, sw 0x" << std::hex << statusword->get<std::uint16_t>();

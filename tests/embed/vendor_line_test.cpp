@@ -10,6 +10,7 @@
 
 #include "embed/testing/network_fixture.hpp"
 #include "slavesim/devices/device_models.hpp"
+#include "support/cia402_steps.hpp"
 #include "support/test_network.hpp"
 
 namespace ecsim::testing {
@@ -111,13 +112,8 @@ TEST_F(VendorLine, LoopSignalsAndACspTurnOfTheVendorDrive) {
   ASSERT_TRUE(controlword.ok() && statusword.ok() && target.ok() && actual.ok() && mode.ok());
   mode->set<std::int8_t>(8);
   auto runUntil = [&](std::uint16_t cw, std::uint16_t mask, std::uint16_t want) {
-    controlword->set<std::uint16_t>(cw);
-    for (int i = 0; i < 50; ++i) {
-      target->set<std::int32_t>(actual->get<std::int32_t>());
-      if (!cycle().ok()) return false;
-      if ((statusword->get<std::uint16_t>() & mask) == want) return true;
-    }
-    return false;
+    return cia402RunUntil(
+        *controlword, *statusword, *target, *actual, [&] { return cycle(); }, cw, mask, want);
   };
   ASSERT_TRUE(runUntil(0x0006, 0x6F, 0x21)) << "Ready to switch on";
   ASSERT_TRUE(runUntil(0x0007, 0x6F, 0x23)) << "Switched on";

@@ -13,45 +13,7 @@
 #include "tests/master/bring_up.hpp"
 #include "tests/master/test_slaves.hpp"
 
-namespace {
-std::atomic<bool> gCounting{false};
-std::atomic<std::uint64_t> gAllocations{0};
-}  // namespace
-
-void* operator new(std::size_t size) {
-  if (gCounting.load(std::memory_order_relaxed)) gAllocations.fetch_add(1);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) {
-  return ::operator new(size);
-}
-void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
-  if (gCounting.load(std::memory_order_relaxed)) gAllocations.fetch_add(1);
-  return std::malloc(size == 0 ? 1 : size);
-}
-void* operator new[](std::size_t size, const std::nothrow_t& tag) noexcept {
-  return ::operator new(size, tag);
-}
-// Every non-aligned form of new and delete is replaced, so that allocation and release always
-// pair malloc with free, also under AddressSanitizer (which reports any mismatch). Aligned
-// forms stay the library's, which pair among themselves.
-// (g++ cannot see that the replaced operator new above mallocs, hence the pragma.)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p, std::size_t) noexcept {
-  std::free(p);
-}
-#pragma GCC diagnostic pop
+#include "support/allocation_counter.hpp"
 
 namespace ecsim::testing {
 namespace {
