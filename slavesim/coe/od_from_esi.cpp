@@ -377,11 +377,11 @@ void setModuleLists(ObjectDictionary& od, const std::vector<std::uint32_t>& iden
   const auto count = static_cast<std::uint8_t>(std::min<std::size_t>(idents.size(), 255));
   for (const std::uint16_t index : {kConfiguredModuleListIndex, kDetectedModuleListIndex}) {
     if (!od.contains(index)) {
-      od.addArray(index,
-                  index == kConfiguredModuleListIndex ? "Configured Module List"
-                                                      : "Detected Module List",
-                  data_type::kUnsigned32, 32, count,
-                  index == kConfiguredModuleListIndex ? access::kReadWrite : access::kReadOnly);
+      od.addArray(
+          index,
+          index == kConfiguredModuleListIndex ? "Configured Module List" : "Detected Module List",
+          data_type::kUnsigned32, 32, count,
+          index == kConfiguredModuleListIndex ? access::kReadWrite : access::kReadOnly);
     }
     fillList(*od.find(index), idents, 4, note);
   }
@@ -419,7 +419,7 @@ ObjectDictionary buildObjectDictionary(const EsiDevice& device, const OdBuildOpt
   }
   addIdentityObject(od, {options.vendorId, device.productCode, device.revision, options.serial});
 
-  if (!od.contains(kSmTypesIndex)) {
+  {
     std::vector<std::uint8_t> types;
     for (const auto& sm : device.syncManagers) types.push_back(smTypeOf(sm));
     // The PDOs assigned to a process-data SM say its direction when its text is wrong (the
@@ -434,7 +434,18 @@ ObjectDictionary buildObjectDictionary(const EsiDevice& device, const OdBuildOpt
       const bool tx = assignedTo(device.txPdos);
       if (rx != tx) types[n] = rx ? kSmTypeOutputs : kSmTypeInputs;
     }
-    addSyncManagerTypes(od, types);
+    auto nonzero = [](const Entry& e) {
+      return e.subindex > 0 &&
+             std::any_of(e.value.begin(), e.value.end(), [](std::uint8_t b) { return b != 0; });
+    };
+    if (Object* existing = od.find(kSmTypesIndex); existing == nullptr) {
+      addSyncManagerTypes(od, types);
+    } else if (std::none_of(existing->entries.begin(), existing->entries.end(), nonzero)) {
+      // The dictionary has 0x1C00 but no value for any SM (Copley's XE2 ESI: <Info/> only): a
+      // device reports its SMs' types there (ETG.1000.6 0x1C00), so they come from its <Sm>.
+      note("0x1C00 gives no SM types: taken from the device's <Sm> elements");
+      fillList(*existing, {types.begin(), types.end()}, 1, note);
+    }
   }
 
   // PDO mapping objects and their rules.
@@ -458,8 +469,7 @@ ObjectDictionary buildObjectDictionary(const EsiDevice& device, const OdBuildOpt
       if (Object* existing = od.find(pdo.index); existing != nullptr) {
         limitWritesToPreOp(*existing, pdo.fixed);
         const std::vector<MappedObject> esiMapping = mappedObjects(od, pdo.index);
-        if (auto conflict = conflictingEntry(od, pdo, created);
-            conflict && !esiMapping.empty()) {
+        if (auto conflict = conflictingEntry(od, pdo, created); conflict && !esiMapping.empty()) {
           // Beckhoff_EL3xxx.xml, EL3632: TxPdo 0x1A41 "Ch2 Sample" names 16 bits of 0x6000:02
           // (Ch1's 1-bit status), the dictionary's 0x1A41 maps 0x6012:01. A PDO that cannot
           // be bound is no description of the device: the dictionary's mapping stays.
@@ -469,15 +479,16 @@ ObjectDictionary buildObjectDictionary(const EsiDevice& device, const OdBuildOpt
           continue;
         }
         addMappedObjects(od, pdo, rx, created);
-        const bool same = std::equal(esiMapping.begin(), esiMapping.end(), entries.begin(),
-                                     entries.end(), [](const auto& a, const auto& b) {
-                                       return a.raw() == b.raw();
-                                     });
+        const bool same =
+            std::equal(esiMapping.begin(), esiMapping.end(), entries.begin(), entries.end(),
+                       [](const auto& a, const auto& b) { return a.raw() == b.raw(); });
         if (!entries.empty() && !same) {
           // As for the assignment: the PDO's own entries win over the dictionary's default.
           if (!esiMapping.empty()) {
-            note(hex4(pdo.index) + ": the dictionary's default mapping differs from the PDO's "
-                 "entries (line " + std::to_string(pdo.line) + "); the PDO's entries are used");
+            note(hex4(pdo.index) +
+                 ": the dictionary's default mapping differs from the PDO's "
+                 "entries (line " +
+                 std::to_string(pdo.line) + "); the PDO's entries are used");
           }
           std::vector<std::uint32_t> raw;
           for (const auto& m : entries) raw.push_back(m.raw());
