@@ -3,8 +3,8 @@
 #include "slavesim/devices/cia402_drive.hpp"
 
 #include <algorithm>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numbers>
 
@@ -23,6 +23,8 @@ namespace {
 constexpr SimTime kMaxCatchUp = 10 * kNsPerSecond;
 constexpr std::uint64_t kFollowingErrorOff = 0xFFFFFFFFu;
 constexpr std::int64_t kDefaultMaxTorquePerMille = 3000;
+// The following error window of ecsim's own drives (examples/esi/ecsim_devices.xml 0x6065).
+constexpr std::int64_t kDefaultFollowingErrorWindow = 10000;
 constexpr std::uint64_t kMaxEncoderResolution = 1u << 30;  // as encoder.resolution
 
 // ETG.6010 multi-axis layout: each further axis has its profile objects 0x800 higher.
@@ -83,7 +85,7 @@ Status Cia402Drive::init() {
   // where only those are mapped.
   auto target = [&](std::uint16_t standard, std::uint16_t demand) {
     return !rxPdoMaps(od_, at(standard)) && rxPdoMaps(od_, at(demand)) ? ref(demand)
-                                                                        : ref(standard);
+                                                                       : ref(standard);
   };
   obj_.errorCode = ref(kErrorCode);
   obj_.controlword = ref(kControlword);
@@ -141,7 +143,14 @@ Status Cia402Drive::init() {
     initialMode = static_cast<std::int8_t>(cia402::Mode::kCyclicSyncPosition);
   }
   if (initialMode) obj_.mode.set(*initialMode);
-  if (params_.followingErrorWindow) obj_.feWindow.set(*params_.followingErrorWindow);
+  if (params_.followingErrorWindow) {
+    obj_.feWindow.set(*params_.followingErrorWindow);
+  } else if (obj_.feWindow && obj_.feWindow.get() == 0) {
+    // A power-up window of 0 (an object the ESI gives no default: Copley's XE2) would make
+    // every count of deviation a following error; a drive ships with a window, so it is taken
+    // as unset (0xFFFFFFFF still switches the check off, CiA 402).
+    obj_.feWindow.set(kDefaultFollowingErrorWindow);
+  }
   if (params_.followingErrorTimeoutMs) obj_.feTimeout.set(*params_.followingErrorTimeoutMs);
   if (params_.maxTorquePerMille) {
     obj_.maxTorque.set(*params_.maxTorquePerMille);
