@@ -83,7 +83,7 @@ struct SegmentCounters {
 // a device or mailbox server and those whose ESC raised events (pollSlaves). Both keep the cost of
 // a frame independent of the number of slaves it passes, so bring-up is linear in the network size
 // (issue #18).
-class Segment : private slavesim::FirmwarePoller {
+class Segment final : private slavesim::FirmwarePoller {
  public:
   Segment() = default;
   ~Segment();
