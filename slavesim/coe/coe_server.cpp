@@ -38,7 +38,26 @@ constexpr std::uint32_t code(SdoAbortCode c) {
 CoeServer::CoeServer(std::shared_ptr<ObjectDictionary> od, CoeServerOptions options)
     : od_(std::move(od)), options_(options) {}
 
+void CoeServer::addProtocol(std::unique_ptr<MailboxProtocol> protocol) {
+  if (protocol == nullptr) return;
+  for (auto& p : protocols_) {
+    if (p->type() == protocol->type()) {
+      p = std::move(protocol);
+      return;
+    }
+  }
+  protocols_.push_back(std::move(protocol));
+}
+
+MailboxProtocol* CoeServer::protocol(MailboxType type) {
+  for (auto& p : protocols_) {
+    if (p->type() == type) return p.get();
+  }
+  return nullptr;
+}
+
 void CoeServer::reset() {
+  for (auto& p : protocols_) p->reset();
   outbox_.clear();
   lastRequest_.clear();
   lastResponses_.clear();
@@ -46,7 +65,7 @@ void CoeServer::reset() {
   download_ = {};
 }
 
-void CoeServer::poll(Esc& esc, SimTime /*now*/) {
+void CoeServer::poll(Esc& esc, SimTime now) {
   const bool available = esc.pdiMailboxAvailable();
   if (!available) {
     if (mailboxWasAvailable_) reset();
@@ -54,6 +73,10 @@ void CoeServer::poll(Esc& esc, SimTime /*now*/) {
     return;
   }
   mailboxWasAvailable_ = true;
+  if (!protocols_.empty()) {
+    mailboxSize_ = sendMailboxSize(esc);
+    for (auto& p : protocols_) p->poll(esc, *this, now);
+  }
   trySend(esc);
 }
 
@@ -86,7 +109,7 @@ void CoeServer::pushEmergency(const Emergency& emergency) {
   queue(std::move(message));
 }
 
-void CoeServer::onRequest(Esc& esc, ConstBytes mailbox, SimTime /*now*/) {
+void CoeServer::onRequest(Esc& esc, ConstBytes mailbox, SimTime now) {
   ++counters_.requests;
   mailboxWasAvailable_ = true;
   mailboxSize_ = sendMailboxSize(esc);
@@ -111,14 +134,19 @@ void CoeServer::onRequest(Esc& esc, ConstBytes mailbox, SimTime /*now*/) {
     lastRequest_.clear();
   }
   recording_ = true;
-  handle(esc, mailbox);
+  handle(esc, mailbox, now);
   recording_ = false;
   trySend(esc);
 }
 
-void CoeServer::handle(Esc& esc, ConstBytes mailbox) {
+void CoeServer::handle(Esc& esc, ConstBytes mailbox, SimTime now) {
   auto message = decodeMailbox(mailbox);
   if (!message.ok()) return sendMailboxError(MailboxErrorCode::kInvalidSize);
+  if (message->header.type != MailboxType::kCoe) {
+    if (MailboxProtocol* p = protocol(message->header.type); p != nullptr) {
+      return p->onMessage(esc, *message, *this, now);
+    }
+  }
   if (message->header.type != MailboxType::kCoe || !options_.coe) {
     return sendMailboxError(MailboxErrorCode::kUnsupportedProtocol);
   }

@@ -23,6 +23,8 @@
 //     "save" / "load" written to sub n makes the current values / the defaults the power-up
 //     values of the objects that sub covers (ObjectDictionary::storePowerUpValues), so they
 //     survive (or are reset by) the next power cycle; another value aborts 0x08000020.
+//   - other protocols (FoE, EoE, SoE: slavesim/mailbox_protocol.hpp) are added with
+//     addProtocol(); their requests reach them through the same counter, retry and queue.
 // When the mailbox SyncManagers are switched off (INIT, a master resetting the slave) every
 // pending transfer, queued message and the retry memory are dropped.
 #pragma once
@@ -36,6 +38,7 @@
 #include "protocol/mailbox.hpp"
 #include "protocol/sdo.hpp"
 #include "slavesim/coe/object_dictionary.hpp"
+#include "slavesim/mailbox_protocol.hpp"
 #include "slavesim/slave.hpp"
 
 namespace ecsim::slavesim::coe {
@@ -58,9 +61,15 @@ struct CoeServerCounters {
   std::uint64_t emergenciesDropped{0};
 };
 
-class CoeServer final : public MailboxServer {
+class CoeServer final : public MailboxServer, private MailboxReplies {
  public:
   explicit CoeServer(std::shared_ptr<ObjectDictionary> od, CoeServerOptions options = {});
+
+  // Answers the requests of protocol->type() from now on (one protocol per type; a second one
+  // for the same type replaces the first).
+  void addProtocol(std::unique_ptr<MailboxProtocol> protocol);
+  // The protocol answering `type`, or null.
+  MailboxProtocol* protocol(MailboxType type);
 
   void onRequest(Esc& esc, ConstBytes mailbox, SimTime now) override;
   void poll(Esc& esc, SimTime now) override;
@@ -71,7 +80,7 @@ class CoeServer final : public MailboxServer {
   ObjectDictionary& dictionary() { return *od_; }
   const CoeServerOptions& options() const { return options_; }
   const CoeServerCounters& counters() const { return counters_; }
-  std::size_t queuedMessages() const { return outbox_.size(); }
+  std::size_t queuedMessages() const override { return outbox_.size(); }
 
  private:
   struct Upload {
@@ -92,7 +101,11 @@ class CoeServer final : public MailboxServer {
     bool toggle{false};
   };
 
-  void handle(Esc& esc, ConstBytes mailbox);
+  // MailboxReplies, for the added protocols.
+  void send(std::vector<std::uint8_t> message) override { queue(std::move(message)); }
+  std::size_t mailboxSize() const override { return mailboxSize_; }
+
+  void handle(Esc& esc, ConstBytes mailbox, SimTime now);
   void handleSdo(Esc& esc, ConstBytes body);
   void handleSdoInfo(Esc& esc, ConstBytes body);
   void upload(Esc& esc, const SdoInitiateUploadRequest& request);
@@ -115,6 +128,7 @@ class CoeServer final : public MailboxServer {
 
   std::shared_ptr<ObjectDictionary> od_;
   CoeServerOptions options_;
+  std::vector<std::unique_ptr<MailboxProtocol>> protocols_;
   CoeServerCounters counters_{};
   std::deque<std::vector<std::uint8_t>> outbox_;
   std::size_t mailboxSize_{0};  // SM1 length of the request being handled
