@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <limits>
 
 namespace ecsim::slavesim::coe {
 
@@ -240,6 +241,8 @@ Object& ObjectDictionary::addVar(std::uint16_t index, std::string name, std::uin
 
 Object& ObjectDictionary::addString(std::uint16_t index, std::string name, std::string_view text,
                                     std::uint16_t accessBits) {
+  constexpr std::size_t kLongestText = std::numeric_limits<std::uint16_t>::max() / 8;
+  text = text.substr(0, std::min(text.size(), kLongestText));
   Object& o = addVar(index, std::move(name), data_type::kVisibleString,
                      static_cast<std::uint16_t>(8 * text.size()), accessBits);
   Entry& e = o.entries.front();

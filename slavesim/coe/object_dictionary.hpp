@@ -148,7 +148,8 @@ class ObjectDictionary {
   // A VAR with its value at sub 0 (value zero, default zero).
   Object& addVar(std::uint16_t index, std::string name, std::uint16_t dataType,
                  std::uint16_t bitLength, std::uint16_t accessBits);
-  // A VISIBLE_STRING VAR holding `text` (bit length 8 * size).
+  // A VISIBLE_STRING VAR holding `text` (bit length 8 * size). An entry's bit length is 16 bits
+  // wide (ETG.1000.6 entry description), so a longer text keeps its first 8191 bytes.
   Object& addString(std::uint16_t index, std::string name, std::string_view text,
                     std::uint16_t accessBits = access::kReadOnly);
   // An ARRAY: sub 0 (UNSIGNED8, = count) and `count` elements of one type.

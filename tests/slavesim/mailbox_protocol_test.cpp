@@ -83,8 +83,7 @@ TEST(MailboxProtocol, ClaimedTypeReachesItsProtocolOnceAndIsRepeatedOnRetry) {
   // progress are dropped.
   requestState(t.seg, kStation, 0x0001);
   for (unsigned sm = 0; sm < 2; ++sm) {
-    one(t.seg, Command::kFpwr, phys(kStation, reg::smChannel(sm)),
-        std::vector<std::uint8_t>(8, 0));
+    one(t.seg, Command::kFpwr, phys(kStation, reg::smChannel(sm)), std::vector<std::uint8_t>(8, 0));
   }
   t.seg.pollSlaves(0);
   EXPECT_EQ(resets, 1);

@@ -159,6 +159,23 @@ TEST_F(InlineEsi, StandardObjectsAreCompleted) {
   EXPECT_TRUE(report_.notes.empty());
 }
 
+// A device name longer than an entry's 16-bit bit length can describe (found by fuzz_esi: the
+// 0x1008 built from a 9000-character <Name> overflowed its value): the first 8191 bytes.
+TEST(OdFromEsi, DeviceNameLongerThanAnEntryCanHoldIsCut) {
+  const std::string name(9000, 'n');
+  const std::string xml = std::string(R"(<EtherCATInfo><Vendor><Id>1</Id></Vendor><Descriptions>
+<Devices><Device><Type ProductCode="#x2" RevisionNo="#x1">T</Type><Name>)") +
+                          name + R"(</Name></Device></Devices></Descriptions></EtherCATInfo>)";
+  auto file = parseEsi(xml, "long-name.xml");
+  ASSERT_TRUE(file.ok()) << file.error().message();
+  const coe::ObjectDictionary od = coe::buildObjectDictionary(file->devices.at(0), {1, 0, 0});
+  const coe::Entry* e = od.findEntry(0x1008, 0);
+  ASSERT_NE(e, nullptr);
+  EXPECT_EQ(e->bitLength, 8191 * 8);
+  EXPECT_EQ(e->value.size(), 8191u);
+  EXPECT_TRUE(std::string(e->value.begin(), e->value.end()) == name.substr(0, 8191));
+}
+
 TEST_F(InlineEsi, MappingObjectsFromThePdos) {
   using M = coe::MappedObject;
   EXPECT_EQ(coe::mappedObjects(od_, 0x1600), (std::vector<M>{{0x6040, 0, 16}, {0x607A, 0, 32}}));
@@ -336,7 +353,8 @@ TEST(OdRealEsi, BeckhoffStepperAndServoAssignments) {
   ASSERT_TRUE(layout.ok()) << layout.error().message();
   ASSERT_FALSE(layout->empty());
   std::uint32_t bits = 0;
-  for (const auto& pdo : servo->devices.at(0).rxPdos) bits += pdo.index == 0x1702 ? pdo.bitLength() : 0;
+  for (const auto& pdo : servo->devices.at(0).rxPdos)
+    bits += pdo.index == 0x1702 ? pdo.bitLength() : 0;
   EXPECT_EQ((*layout)[0].bitLength, bits) << "what the slave accepts at PREOP->SAFEOP";
 }
 
