@@ -82,6 +82,24 @@ Status Segment::connect(std::size_t a, unsigned pa, std::size_t b, unsigned pb, 
   return okStatus();
 }
 
+Status Segment::setRedundantPort(std::size_t slave, unsigned port, double metres) {
+  if (slave >= slaves_.size() || port >= slaves_[slave]->esc().type().maxPorts) {
+    return makeError(ErrorCode::kInvalidArgument,
+                     "redundant port: slave or port out of range (or not on its ESC)");
+  }
+  if ((slave == 0 && port == 0) || links_[slave][port].slave != kNoSlave) {
+    return makeError(ErrorCode::kInvalidArgument, "redundant port: " + slaves_[slave]->name() +
+                                                      " port " + std::to_string(port) +
+                                                      " is already connected");
+  }
+  redSlave_ = static_cast<int>(slave);
+  redPort_ = static_cast<std::uint8_t>(port);
+  redCable_ = metres;
+  routeValid_ = false;
+  refreshLinkStatus(slave);
+  return okStatus();
+}
+
 void Segment::wireLine(double metres) {
   for (std::size_t i = 1; i < slaves_.size(); ++i) {
     (void)connect(i - 1, 1, i, 0, metres);
@@ -110,10 +128,9 @@ void Segment::setDelays(std::size_t slave, SimTime processing, SimTime forwardin
 }
 
 bool Segment::portLink(std::size_t s, unsigned p) const {
-  if (s == 0 && p == 0) return linkUp_[0][0];  // the master's cable
+  if (masterEnd(s, p)) return linkUp_[s][p];  // a cable to the master
   const PortLink& l = links_[s][p];
-  return l.slave != kNoSlave && linkUp_[s][p] &&
-         linkUp_[static_cast<std::size_t>(l.slave)][l.port];
+  return l.slave != kNoSlave && linkUp_[s][p] && linkUp_[static_cast<std::size_t>(l.slave)][l.port];
 }
 
 bool Segment::portOpen(std::size_t s, unsigned p) const {
@@ -123,8 +140,8 @@ bool Segment::portOpen(std::size_t s, unsigned p) const {
   // not have is closed.
   const auto& esc = slaves_[s]->esc();
   if (p >= esc.type().maxPorts) return false;
-  const std::uint8_t loop = reg::dl_control::loopSetting(
-      static_cast<std::uint8_t>(esc.read(reg::kDlControl) >> 8), p);
+  const std::uint8_t loop =
+      reg::dl_control::loopSetting(static_cast<std::uint8_t>(esc.read(reg::kDlControl) >> 8), p);
   if (loop == reg::dl_control::kLoopClosed) return false;
   return loop == reg::dl_control::kLoopOpen || portLink(s, p);
 }
@@ -199,12 +216,18 @@ void Segment::revertTemporaryLoops(SimTime now) {
   }
 }
 
-FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
+FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime, MasterPort from) {
   FrameOutcome outcome;
+  outcome.exit = from;
   if (sendTime >= nextLoopRevert_) revertTemporaryLoops(sendTime);
   auto parsed = EtherCatFrame::parse(frame);
-  // Nothing is received at slave 0 without the master's link or with its port 0 closed.
-  if (!parsed.ok() || slaves_.empty() || !linkUp_[0][0] || (openMask_[0] & 1u) == 0) {
+  const bool secondary = from == MasterPort::kSecondary;
+  // Where the frame enters: slave 0's port 0, or the port wired to the master's second port.
+  const std::uint32_t s0 = secondary ? static_cast<std::uint32_t>(redSlave_) : 0;
+  const std::uint8_t p0 = secondary ? redPort_ : 0;
+  // Nothing is received without the master's link or with the port it arrives at closed.
+  if (!parsed.ok() || slaves_.empty() || (secondary && redSlave_ == kNoSlave) || !linkUp_[s0][p0] ||
+      (openMask_[s0] & (1u << p0)) == 0) {
     if (!parsed.ok()) ++counters_.framesMalformed;
     return outcome;
   }
@@ -229,7 +252,9 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
   latched_.clear();
   const SimTime frameTime =
       static_cast<SimTime>(8 + std::max<std::size_t>(frame.size(), kMinFrameSize) + 4) * nsPerByte;
-  if (routeValid_ && faults_ == nullptr && !anyObserver_) {
+  // With a second master port the way depends on where the frame enters and on breaks in the
+  // ring: every frame walks (rings are short next to the lines the recorded route is for).
+  if (routeValid_ && faults_ == nullptr && !anyObserver_ && !redundant()) {
     // The wiring, port states and delays have not changed since the route was recorded: the
     // frame reaches the same ESCs in the same order at the same times relative to sendTime.
     passRoute(count, leads, sendTime);
@@ -246,25 +271,26 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
   // The walk, recording the route for the frames that follow (not with faults: they may delay).
   // A walk with faults keeps the recorded route: clearing it while routeValid_ stays set made
   // the next fault-free frame reach no ESC at all (WKC 0).
-  const bool record = faults_ == nullptr;
+  const bool record = faults_ == nullptr && !redundant();
   if (record) {
     routeChanging();
     route_.clear();
   }
   stack_.clear();
   for (auto& m : arrivalMask_) m = 0;
-  std::uint32_t s = 0;
-  std::uint8_t k = 0;
-  notify(0, 0, frame, sendTime, true);
-  SimTime t = sendTime + cableDelay(masterCable_);
+  std::uint32_t s = s0;
+  std::uint8_t k = p0;
+  notify(s0, p0, frame, sendTime, true);
+  const double entryCable = secondary ? redCable_ : masterCable_;
+  SimTime t = sendTime + cableDelay(entryCable);
   // Corrupted on the way (fault injection): counted, lost for the master, and processed by
   // the ESCs behind the fault as an invalid frame (Esc::beginFrame).
   bool bad = false;
   bool lost = false;  // lost at a port by its loop setting (never returns to the master)
-  if (faults_ != nullptr) arriveWithFaults(0, 0, t, bad);
-  stack_.push_back({0, 0, 0});
-  arrival_[0][0] = t;
-  arrivalMask_[0] = 1;
+  if (faults_ != nullptr) arriveWithFaults(s0, p0, t, bad);
+  stack_.push_back({s0, p0, p0});
+  arrival_[s0][p0] = t;
+  arrivalMask_[s0] = static_cast<std::uint8_t>(1u << p0);
   // A passage through an ESC costs its processing delay when it went through the processing
   // unit (entered at port 0) and its forwarding delay otherwise; looping back through a closed
   // port inside the ESC adds nothing (section I §9.1.2, Table 30).
@@ -297,9 +323,9 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
     if (upstream) {
       const std::uint8_t entry = top.entryPort;
       stack_.pop_back();
-      if (stack_.empty()) {
-        notify(0, 0, frame, tOut, false);
-        outcome.firstBitRoundTrip = tOut + cableDelay(masterCable_) - sendTime;
+      if (stack_.empty()) {  // back out of the port it came in at
+        notify(s0, p0, frame, tOut, false);
+        outcome.firstBitRoundTrip = tOut + cableDelay(entryCable) - sendTime;
         break;
       }
       Visit& parent = stack_.back();
@@ -308,6 +334,14 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime) {
       s = parent.slave;
       k = parent.port;
       t = tOut + cableNs_[s][k];  // the cable just crossed (both ends hold its delay)
+    } else if (masterEnd(s, out)) {
+      // Out to the master's other port: the frame went round the ring (entering at slave 0's
+      // port 0 it leaves at the redundant port, and the other way round).
+      notify(s, out, frame, tOut, false);
+      outcome.exit = secondary ? MasterPort::kPrimary : MasterPort::kSecondary;
+      outcome.firstBitRoundTrip =
+          tOut + cableDelay(secondary ? masterCable_ : redCable_) - sendTime;
+      break;
     } else {
       const PortLink& l = links_[s][out];
       notify(s, out, frame, tOut, true);

@@ -63,8 +63,15 @@ class WireFaults {
 };
 constexpr SimTime kMaxWireExtraDelay = 3600 * kNsPerSecond;
 
+// The master's ports: the primary one at slave 0's port 0 and, with cable redundancy, the
+// second one wired to a free port at the far end of the line (setRedundantPort).
+enum class MasterPort : std::uint8_t { kPrimary, kSecondary };
+
 struct FrameOutcome {
   bool delivered{false};  // false: dropped (malformed or lost)
+  // The master port the frame comes back at: the one it was sent from, or on a whole
+  // redundant ring the other one (it went round the ring).
+  MasterPort exit{MasterPort::kPrimary};
   SimTime returnTime{0};  // when the last bit is back at the master
   SimTime firstBitRoundTrip{0};
 };
@@ -100,6 +107,15 @@ class Segment final : private slavesim::FirmwarePoller {
     masterCable_ = metres;
     routeValid_ = false;
   }
+  // Cable redundancy: `slave`'s free port `port` is wired to the master's second port (the
+  // ring closed back to the master, ETG.1000.4 §4.4 "line redundancy"). A frame the master
+  // sends there enters that ESC at that port; frames leave the network at whichever master
+  // port their way through the ESCs' forwarding ends at (FrameOutcome::exit). Its link is
+  // setLinkUp(slave, port, ...), as the master's own cable is (0, 0).
+  Status setRedundantPort(std::size_t slave, unsigned port, double metres = 1.0);
+  bool redundant() const { return redSlave_ != kNoSlave; }
+  std::size_t redundantSlave() const { return static_cast<std::size_t>(redSlave_); }
+  unsigned redundantPortNumber() const { return redPort_; }
   // Observes the cable at `slave`'s port `port` (both directions); nullptr removes it. The
   // cable between the master and slave 0 is (0, 0).
   void setCableObserver(std::size_t slave, unsigned port, CableObserver* observer);
@@ -116,9 +132,10 @@ class Segment final : private slavesim::FirmwarePoller {
   const slavesim::Slave& slave(std::size_t i) const { return *slaves_[i]; }
   const std::array<PortLink, kPortCount>& ports(std::size_t i) const { return links_[i]; }
 
-  // Processes a frame in place. sendTime is when its first bit leaves the master. A frame
-  // that is not a valid EtherCAT frame is left untouched, counted and reported as dropped.
-  FrameOutcome processFrame(Bytes frame, SimTime sendTime);
+  // Processes a frame in place. sendTime is when its first bit leaves the master (from its
+  // port `entry`). A frame that is not a valid EtherCAT frame is left untouched, counted and
+  // reported as dropped; so is one sent from the second port of a master without redundancy.
+  FrameOutcome processFrame(Bytes frame, SimTime sendTime, MasterPort entry = MasterPort::kPrimary);
   // Runs every slave's firmware (call after frames and on the device tick).
   void pollSlaves(SimTime now);
 
@@ -148,6 +165,13 @@ class Segment final : private slavesim::FirmwarePoller {
  private:
   bool portOpen(std::size_t slave, unsigned port) const;
   bool portLink(std::size_t slave, unsigned port) const;
+  // The port is wired to one of the master's ports: (0, 0), or the redundant one.
+  bool masterEnd(std::size_t slave, unsigned port) const {
+    return (slave == 0 && port == 0) || (static_cast<int>(slave) == redSlave_ && port == redPort_);
+  }
+  int redSlave_{kNoSlave};
+  std::uint8_t redPort_{0};
+  double redCable_{1.0};
   // Loop control (issue #15 item 6): a DL control write seen after a frame at time `now`
   // (bit 1 set: the loop setting is temporary and reverts kTemporaryLoopNs later), and the
   // revert of temporary settings that are due.
