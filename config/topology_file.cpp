@@ -22,7 +22,9 @@ Result<std::pair<std::size_t, unsigned>> parseEndpoint(const xml::Context& ctx, 
                                                        const char* attribute,
                                                        const TopologyConfig& cfg) {
   const char* raw = e->Attribute(attribute);
-  if (raw == nullptr) return ctx.error(e, std::string("Link needs attribute '") + attribute + "'");
+  if (raw == nullptr) {
+    return ctx.error(e, std::string(e->Name()) + " needs attribute '" + attribute + "'");
+  }
   std::string_view text(raw);
   auto colon = text.rfind(':');
   if (colon == std::string_view::npos) {
@@ -76,14 +78,15 @@ const xml::Names kTopologyNames{{"name"}, {"Master", "Slave", "Link", "Eni"}, {"
 // carry only behaviour (model, parameters, inputs, state file).
 const xml::Names kEniNames{{"file", "esiDir"}};
 const xml::Names kEniSlaveNames{{"name", "model", "stateFile"}, {"Input", "Param"}};
-const xml::Names kMasterNames{{"cable"}};
-const xml::Names kSlaveNames{{"name", "esi", "product", "revision", "device", "eeprom", "esc",
-                              "dc", "processingDelayNs", "forwardingDelayNs", "stateFile",
-                              "modules", "model"},
-                             {"Clock", "Input", "Param", "Module"},
-                             {"Clock"}};
+const xml::Names kMasterNames{{"cable", "redundant", "redundantCable"}};
+const xml::Names kSlaveNames{
+    {"name", "esi", "product", "revision", "device", "eeprom", "esc", "dc", "processingDelayNs",
+     "forwardingDelayNs", "stateFile", "modules", "model"},
+    {"Clock", "Input", "Param", "Module"},
+    {"Clock"}};
 // <Slave model="...">: the device models a topology may choose (docs/devices.md).
-const std::vector<std::string_view> kModelNames{"cia402", "io", "analog", "encoder", "loopback", "none"};
+const std::vector<std::string_view> kModelNames{"cia402",  "io",       "analog",
+                                                "encoder", "loopback", "none"};
 const xml::Names kClockNames{{"offsetNs", "driftPpm"}};
 const xml::Names kInputNames{{"entry", "value"}};
 const xml::Names kParamNames{{"name", "value"}};
@@ -210,14 +213,15 @@ Result<TopologyConfig> parseEniTopology(const xml::Context& ctx, const Element* 
                                         const std::filesystem::path& folder) {
   ECSIM_TRY(xml::checkNames(ctx, eniElement, kEniNames));
   const char* eniName = eniElement->Attribute("file");
-  if (eniName == nullptr || *eniName == 0) return ctx.error(eniElement, "Eni needs file=\"ENI.xml\"");
+  if (eniName == nullptr || *eniName == 0)
+    return ctx.error(eniElement, "Eni needs file=\"ENI.xml\"");
   if (const Element* link = root->FirstChildElement("Link")) {
     return ctx.error(link, "a topology on an <Eni> takes its wiring from the ENI: no <Link>");
   }
   const std::filesystem::path eniFile = folder / eniName;
   const char* esiDir = eniElement->Attribute("esiDir");
-  const std::filesystem::path esiFolder = esiDir != nullptr ? folder / esiDir
-                                                            : eniFile.parent_path();
+  const std::filesystem::path esiFolder =
+      esiDir != nullptr ? folder / esiDir : eniFile.parent_path();
   auto eni = loadEniFile(eniFile);
   if (!eni.ok()) return ctx.error(eniElement, eni.error().message());
   auto built = topology::topologyFromEni(*eni, {esiFolder});
@@ -240,12 +244,12 @@ Result<TopologyConfig> parseEniTopology(const xml::Context& ctx, const Element* 
     if (name == nullptr || *name == 0) return ctx.error(e, "Slave needs a name attribute");
     const auto found = cfg.byName.find(std::string_view(name));
     if (found == cfg.byName.end()) {
-      return ctx.error(e, unknownNameText("slave", name, names,
-                                          " in " + eniFile.filename().string()));
+      return ctx.error(e,
+                       unknownNameText("slave", name, names, " in " + eniFile.filename().string()));
     }
     if (auto [it, fresh] = given.emplace(found->second, e->GetLineNum()); !fresh) {
-      return ctx.error(e, fmt::format("slave '{}' given twice (first on line {})", name,
-                                      it->second));
+      return ctx.error(e,
+                       fmt::format("slave '{}' given twice (first on line {})", name, it->second));
     }
     TopologySlave& s = cfg.slaves[found->second];
     ECSIM_TRY(parseModel(ctx, e, s));
@@ -267,8 +271,8 @@ Status checkWiring(const xml::Context& ctx, const TopologyConfig& cfg) {
       return ctx.error(l.line, "cable name 'master' is the master's cable (to the first slave)");
     }
     if (auto [it, fresh] = names.emplace(l.name, l.line); !fresh) {
-      return ctx.error(l.line, fmt::format("cable name '{}' given twice (first on line {})",
-                                           l.name, it->second));
+      return ctx.error(l.line, fmt::format("cable name '{}' given twice (first on line {})", l.name,
+                                           it->second));
     }
   }
   std::vector<std::vector<std::size_t>> neighbours(cfg.slaves.size());
@@ -327,12 +331,19 @@ Result<TopologyConfig> parseTopology(std::string_view text, const std::filesyste
   cfg.file = file;
   if (const char* name = root->Attribute("name")) cfg.name = name;
   const std::filesystem::path folder = file.parent_path();
-  if (const Element* master = root->FirstChildElement("Master")) {
+  const Element* master = root->FirstChildElement("Master");
+  if (master != nullptr) {
     ECSIM_TRY(xml::checkNames(ctx, master, kMasterNames));
     ECSIM_ASSIGN_OR_RETURN(cfg.masterCableMetres,
                            attrDouble(ctx, master, "cable", 1.0, 0, kMaxCableMetres, kCableWhy));
+    ECSIM_ASSIGN_OR_RETURN(cfg.redundantCableMetres, attrDouble(ctx, master, "redundantCable", 1.0,
+                                                                0, kMaxCableMetres, kCableWhy));
+    cfg.masterLine = master->GetLineNum();
   }
   if (const Element* eniElement = root->FirstChildElement("Eni")) {
+    if (master != nullptr && master->Attribute("redundant") != nullptr) {
+      return ctx.error(master, "redundant: not with <Eni> (the ENI gives the wiring)");
+    }
     ECSIM_ASSIGN_OR_RETURN(TopologyConfig onEni, parseEniTopology(ctx, root, eniElement, folder));
     onEni.file = file;
     onEni.name = cfg.name.empty() ? onEni.name : cfg.name;
@@ -370,6 +381,20 @@ Result<TopologyConfig> parseTopology(std::string_view text, const std::filesyste
   if (!cfg.explicitLinks) {  // a line in the written order, port 1 -> port 0
     for (std::size_t i = 1; i < cfg.slaves.size(); ++i) {
       cfg.links.push_back({"", i - 1, 1, i, 0, 1.0, cfg.slaves[i].line});
+    }
+  }
+  if (master != nullptr && master->Attribute("redundant") != nullptr) {
+    ECSIM_ASSIGN_OR_RETURN(cfg.redundantPort, parseEndpoint(ctx, master, "redundant", cfg));
+    for (const auto& l : cfg.links) {
+      if ((l.fromSlave == cfg.redundantPort->first && l.fromPort == cfg.redundantPort->second) ||
+          (l.toSlave == cfg.redundantPort->first && l.toPort == cfg.redundantPort->second)) {
+        return ctx.error(master, fmt::format("redundant: {}:{} is already wired (line {})",
+                                             cfg.slaves[cfg.redundantPort->first].name,
+                                             cfg.redundantPort->second, l.line));
+      }
+    }
+    if (*cfg.redundantPort == std::pair<std::size_t, unsigned>{0, 0}) {
+      return ctx.error(master, "redundant: port 0 of the first slave is the master's own cable");
     }
   }
   for (auto& l : cfg.links) {

@@ -62,7 +62,7 @@ struct TopologySlave {
   std::int64_t clockOffsetNs{0};
   double driftPpm{0.0};
   std::vector<TopologyInput> inputs;
-  std::filesystem::path stateFile;    // persistent device state (e.g. absolute encoder)
+  std::filesystem::path stateFile;  // persistent device state (e.g. absolute encoder)
   // The device model (model="cia402|none"); empty: chosen from the ESI (docs/devices.md).
   std::string model;
   std::vector<TopologyParam> params;  // device model parameters, in the written order
@@ -88,6 +88,11 @@ struct TopologyConfig {
   std::string name;
   std::filesystem::path file;
   double masterCableMetres{1.0};
+  // Cable redundancy (<Master redundant="SLAVE:PORT">): the slave's port wired to the master's
+  // second port, and that cable's length.
+  std::optional<std::pair<std::size_t, unsigned>> redundantPort;
+  double redundantCableMetres{1.0};
+  int masterLine{0};
   std::vector<TopologySlave> slaves;  // in the order written; slave 0 is at the master
   std::vector<TopologyLink> links;    // empty in the file: a line in written order
   bool explicitLinks{false};

@@ -115,8 +115,8 @@ Result<std::unique_ptr<slavesim::Slave>> SlaveFactory::make(const TopologySlave&
     return e;
   }
   for (auto& n : notes) {
-    warnings_.push_back("slave '" + entry.name + "' (" + entry.esiFile.string() + "): " +
-                        std::move(n));
+    warnings_.push_back("slave '" + entry.name + "' (" + entry.esiFile.string() +
+                        "): " + std::move(n));
   }
   if (!entry.params.empty() && slavesim::devices::deviceModelOf(**slave) == nullptr) {
     return at(entry, "Param given, but this device has no model of ecsim with parameters" +
@@ -145,8 +145,7 @@ Result<const EsiFile*> SlaveFactory::esiFile(const std::filesystem::path& path) 
     auto file = loadEsiFile(path);
     if (!file.ok()) return file.takeError();
     found = esiFiles_.emplace(path, std::move(file).value()).first;
-    warnings_.insert(warnings_.end(), found->second.warnings.begin(),
-                     found->second.warnings.end());
+    warnings_.insert(warnings_.end(), found->second.warnings.begin(), found->second.warnings.end());
   }
   return &found->second;
 }
@@ -201,8 +200,7 @@ Result<EsiDevice> SlaveFactory::withModules(const TopologySlave& entry, const Es
       const std::string what =
           m.ident ? fmt::format("no module with ModuleIdent #x{:08X} in the ESI files", *m.ident)
                   : unknownNameText("module type", m.type, catalog.typeNames());
-      return makeError(ErrorCode::kInvalidArgument,
-                       "line " + std::to_string(m.line) + ": " + what);
+      return makeError(ErrorCode::kInvalidArgument, "line " + std::to_string(m.line) + ": " + what);
     }
     chosen.push_back(module);
   }
@@ -325,6 +323,18 @@ Result<Network> buildNetwork(const TopologyConfig& config) {
       return e;
     }
     net.cables.push_back({link.name, link.toSlave, link.toPort});
+  }
+  if (config.redundantPort) {
+    const auto [slave, port] = *config.redundantPort;
+    // Its link is down until a master's second port is there (ecsim serve --redundant-iface):
+    // a master without one sees an open ring, as on hardware with that cable unplugged.
+    if (auto s = seg.setRedundantPort(slave, port, config.redundantCableMetres, false); !s.ok()) {
+      Error e = s.takeError();
+      e.context =
+          config.file.string() + ", line " + std::to_string(config.masterLine) + ": " + e.context;
+      return e;
+    }
+    net.cables.push_back({"redundant", slave, port});
   }
   net.warnings.insert(net.warnings.end(), config.warnings.begin(), config.warnings.end());
   net.warnings.insert(net.warnings.end(), factory.warnings().begin(), factory.warnings().end());

@@ -55,6 +55,11 @@ class NetworkServer {
  public:
   NetworkServer(Link& link, Segment& segment, const Clock& clock, ServerOptions options = {});
 
+  // Cable redundancy: the master's second port (Segment::setRedundantPort). Frames from either
+  // link enter the network at that master port and go back out of the link at the master port
+  // they leave the network at (on a whole ring, the other one). Not owned; null: none.
+  void setRedundantLink(Link* link) { redundant_ = link; }
+
   // Waits up to the idle wait for one frame, processes and answers it, runs the firmware.
   Status step();
   // Steps until stop() returns true; stop() is also consulted during a paced wait.
@@ -64,8 +69,14 @@ class NetworkServer {
 
  private:
   Link& link_;
+  Link* redundant_{nullptr};
+  bool redundantFirst_{false};  // which link is looked at first (they take turns)
   Segment& segment_;
+  // A frame from either link (redundancy): its length, and the master port it came from.
+  Result<std::size_t> receiveEither(std::chrono::nanoseconds wait, MasterPort& from);
   Status step(const std::function<bool()>& stop);
+  // Waits up to `wait` for one frame, answers it and runs the firmware.
+  Status answer(std::chrono::nanoseconds wait, const std::function<bool()>& stop);
   // Paced: holds until `t` on the clock; false when stop() was raised first.
   bool waitUntil(SimTime t, const std::function<bool()>& stop);
   // Runs the firmware now, or (firmwareSpacing) only when it is due; `idle`: always.

@@ -82,7 +82,7 @@ Status Segment::connect(std::size_t a, unsigned pa, std::size_t b, unsigned pb, 
   return okStatus();
 }
 
-Status Segment::setRedundantPort(std::size_t slave, unsigned port, double metres) {
+Status Segment::setRedundantPort(std::size_t slave, unsigned port, double metres, bool linked) {
   if (slave >= slaves_.size() || port >= slaves_[slave]->esc().type().maxPorts) {
     return makeError(ErrorCode::kInvalidArgument,
                      "redundant port: slave or port out of range (or not on its ESC)");
@@ -95,6 +95,7 @@ Status Segment::setRedundantPort(std::size_t slave, unsigned port, double metres
   redSlave_ = static_cast<int>(slave);
   redPort_ = static_cast<std::uint8_t>(port);
   redCable_ = metres;
+  linkUp_[slave][port] = linked;
   routeValid_ = false;
   refreshLinkStatus(slave);
   return okStatus();

@@ -111,8 +111,9 @@ class Segment final : private slavesim::FirmwarePoller {
   // ring closed back to the master, ETG.1000.4 §4.4 "line redundancy"). A frame the master
   // sends there enters that ESC at that port; frames leave the network at whichever master
   // port their way through the ESCs' forwarding ends at (FrameOutcome::exit). Its link is
-  // setLinkUp(slave, port, ...), as the master's own cable is (0, 0).
-  Status setRedundantPort(std::size_t slave, unsigned port, double metres = 1.0);
+  // setLinkUp(slave, port, ...), as the master's own cable is (0, 0); `linked` is its state now.
+  Status setRedundantPort(std::size_t slave, unsigned port, double metres = 1.0,
+                          bool linked = true);
   bool redundant() const { return redSlave_ != kNoSlave; }
   std::size_t redundantSlave() const { return static_cast<std::size_t>(redSlave_); }
   unsigned redundantPortNumber() const { return redPort_; }

@@ -18,25 +18,6 @@
 namespace ecsim::testing {
 namespace {
 
-struct CtlResult {
-  int status{-1};
-  std::string out;
-};
-
-CtlResult ctl(const std::string& socket, const std::vector<std::string>& words) {
-  std::vector<std::string> argv{kEcsim, "ctl", "--socket", socket};
-  argv.insert(argv.end(), words.begin(), words.end());
-  const std::string log = ::testing::TempDir() + "ctl_" + std::to_string(::getpid()) + ".log";
-  CtlResult r;
-  auto child = spawnProcess(argv, SpawnOptions{log, log});
-  if (!child.ok()) return r;
-  auto rc = child->wait(std::chrono::seconds(10));  // a bound against a hang only
-  r.status = rc.ok() ? *rc : -1;
-  r.out = readText(log);
-  std::filesystem::remove(log);
-  return r;
-}
-
 TEST(CtlOutputs, EcsimCtlGetReadsWhatSoemWroteToDO1) {
   ECSIM_REQUIRE_SOEM();
   const auto client = kSoem / "bin-v1" / "output_client";
@@ -50,21 +31,12 @@ TEST(CtlOutputs, EcsimCtlGetReadsWhatSoemWroteToDO1) {
   const std::string socket = ::testing::TempDir() + "ecsim_ctl_" + tag + ".sock";
   const std::string serveLog = ::testing::TempDir() + "ctl_serve_" + tag + ".log";
   const std::string masterLog = ::testing::TempDir() + "ctl_master_" + tag + ".log";
-  auto server = ns->spawn({kEcsim, "serve", "--rt", "--iface", ns->simulatorInterface(),
-                           "--control", socket,
-                           std::string(ECSIM_SOURCE_DIR) + "/examples/topologies/demo.xml"},
-                          SpawnOptions{serveLog, serveLog});
+  auto server =
+      ns->spawn({kEcsim, "serve", "--rt", "--iface", ns->simulatorInterface(), "--control", socket,
+                 std::string(ECSIM_SOURCE_DIR) + "/examples/topologies/demo.xml"},
+                SpawnOptions{serveLog, serveLog});
   ASSERT_TRUE(server.ok()) << server.error().message();
-  auto waitFor = [](const std::string& file, const std::string& text, ChildProcess& process,
-                    std::chrono::seconds limit) {
-    const auto deadline = std::chrono::steady_clock::now() + limit;
-    while (readText(file).find(text) == std::string::npos && process.running() &&
-           std::chrono::steady_clock::now() < deadline) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-    return readText(file).find(text) != std::string::npos;
-  };
-  ASSERT_TRUE(waitFor(serveLog, "ecsim: control socket", *server, std::chrono::seconds(20)))
+  ASSERT_TRUE(waitForText(serveLog, "ecsim: control socket", *server, std::chrono::seconds(20)))
       << readText(serveLog);
   // Before the master: DO1 is in INIT and its outputs are off.
   EXPECT_EQ(ctl(socket, {"get", "DO1", "Output 8"}).out, "0\n");
@@ -74,17 +46,16 @@ TEST(CtlOutputs, EcsimCtlGetReadsWhatSoemWroteToDO1) {
       {kEcsim, "ctl", "--socket", socket, "subscribe", "DO1", "Output 8", "--count", "1"},
       SpawnOptions{subscribeLog, subscribeLog});
   ASSERT_TRUE(subscriber.ok()) << subscriber.error().message();
-  ASSERT_TRUE(waitFor(subscribeLog, "DO1.Output 8 0", *subscriber, std::chrono::seconds(10)))
+  ASSERT_TRUE(waitForText(subscribeLog, "DO1.Output 8 0", *subscriber, std::chrono::seconds(10)))
       << readText(subscribeLog);
 
   // DO1 is SOEM's slave 3 (Coupler 1, DI1 2); 30 s of cycles bound the test, it stops the
   // master when done.
-  auto master = ns->spawn(
-      withRealtimePriority({"timeout", "60", client.string(), ns->masterInterface(), "3", "0xA5",
-                            "30"}),
-      SpawnOptions{masterLog, masterLog});
+  auto master = ns->spawn(withRealtimePriority({"timeout", "60", client.string(),
+                                                ns->masterInterface(), "3", "0xA5", "30"}),
+                          SpawnOptions{masterLog, masterLog});
   ASSERT_TRUE(master.ok()) << master.error().message();
-  ASSERT_TRUE(waitFor(masterLog, "op outputs 0xa5", *master, std::chrono::seconds(40)))
+  ASSERT_TRUE(waitForText(masterLog, "op outputs 0xa5", *master, std::chrono::seconds(40)))
       << "the master did not reach OP:\n"
       << readText(masterLog) << "\nserve:\n"
       << readText(serveLog);

@@ -73,6 +73,37 @@ inline std::vector<std::string> withRealtimePriority(std::vector<std::string> ar
   return rt;
 }
 
+// `ecsim ctl --socket SOCKET WORDS...`: its exit status and output.
+struct CtlResult {
+  int status{-1};
+  std::string out;
+};
+
+inline CtlResult ctl(const std::string& socket, const std::vector<std::string>& words) {
+  std::vector<std::string> argv{kEcsim, "ctl", "--socket", socket};
+  argv.insert(argv.end(), words.begin(), words.end());
+  const std::string log = ::testing::TempDir() + "ctl_" + std::to_string(::getpid()) + ".log";
+  CtlResult r;
+  auto child = spawnProcess(argv, SpawnOptions{log, log});
+  if (!child.ok()) return r;
+  auto rc = child->wait(std::chrono::seconds(10));  // a bound against a hang only
+  r.status = rc.ok() ? *rc : -1;
+  r.out = readText(log);
+  std::filesystem::remove(log);
+  return r;
+}
+
+// Waits until `file` holds `text` while `process` runs, at most `limit`.
+inline bool waitForText(const std::string& file, const std::string& text, ChildProcess& process,
+                        std::chrono::seconds limit) {
+  const auto deadline = std::chrono::steady_clock::now() + limit;
+  while (readText(file).find(text) == std::string::npos && process.running() &&
+         std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return readText(file).find(text) != std::string::npos;
+}
+
 #define ECSIM_REQUIRE_SOEM()                                                            \
   do {                                                                                  \
     if (auto caps = checkNetworkCapabilities(); !caps.ok()) {                           \

@@ -42,7 +42,9 @@ struct Case {
   std::string expected;  // the suggestion ("did you mean 'X'?") or what is inconsistent
 };
 
-void PrintTo(const Case& c, std::ostream* os) { *os << c.label; }
+void PrintTo(const Case& c, std::ostream* os) {
+  *os << c.label;
+}
 
 // The topology the scenario and control rows are checked against.
 const std::string kNet =
@@ -61,7 +63,9 @@ const std::string kExpect = "<Expect><State slave=\"Drive1\" state=\"OP\"/></Exp
 const std::string kEnd = "</Scenario>\n";
 const std::string kExternal = "<Master kind=\"external\" command=\"true\"/>\n";
 
-std::string scenario(const std::string& body) { return kHead + body + kEnd; }
+std::string scenario(const std::string& body) {
+  return kHead + body + kEnd;
+}
 std::string timeline(const std::string& action) {  // the action on line 3
   return scenario("<Timeline>\n" + action + "\n</Timeline>\n" + kExpect);
 }
@@ -154,6 +158,17 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"Master cabel", Format::kTopology,
              "<Topology>\n<Master cabel=\"20\"/>\n<Slave name=\"A\"/>\n</Topology>\n", 2,
              "unknown attribute 'cabel' on <Master>; did you mean 'cable'?"},
+        Case{"Master redundnat", Format::kTopology,
+             "<Topology>\n<Master redundnat=\"A:1\"/>\n<Slave name=\"A\"/>\n</Topology>\n", 2,
+             "unknown attribute 'redundnat' on <Master>; did you mean 'redundant'?"},
+        // A cable redundancy port must be free: the ring's last cable cannot share a port.
+        Case{"redundant port wired", Format::kTopology,
+             "<Topology>\n<Master redundant=\"A:1\"/>\n<Slave name=\"A\"/>\n"
+             "<Slave name=\"B\"/>\n</Topology>\n",
+             2, "redundant: A:1 is already wired"},
+        Case{"redundant at the master", Format::kTopology,
+             "<Topology>\n<Master redundant=\"A:0\"/>\n<Slave name=\"A\"/>\n</Topology>\n", 2,
+             "port 0 of the first slave is the master's own cable"},
         Case{"Link cabel", Format::kTopology,
              "<Topology>\n<Slave name=\"A\"/>\n<Slave name=\"B\"/>\n"
              "<Link from=\"A:1\" to=\"B:0\" cabel=\"20\"/>\n</Topology>\n",
@@ -182,9 +197,8 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"forwardDelayNs", Format::kTopology,
              "<Topology>\n<Slave name=\"A\" forwardDelayNs=\"500\"/>\n</Topology>\n", 2,
              "did you mean 'forwardingDelayNs'?"},
-        Case{"nmae", Format::kTopology,
-             "<Topology nmae=\"x\">\n<Slave name=\"A\"/>\n</Topology>\n", 1,
-             "did you mean 'name'?"},
+        Case{"nmae", Format::kTopology, "<Topology nmae=\"x\">\n<Slave name=\"A\"/>\n</Topology>\n",
+             1, "did you mean 'name'?"},
         Case{"two Clocks", Format::kTopology,
              "<Topology>\n<Slave name=\"A\">\n<Clock offsetNs=\"5\"/>\n<Clock driftPpm=\"1\"/>\n"
              "</Slave>\n</Topology>\n",
@@ -209,8 +223,8 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         // The issue's example: the run lasted the default second, the faults never happened.
         Case{"durationMS", Format::kScenario,
-             "<Scenario name=\"t\" topology=\"net.xml\" durationMS=\"3000\">\n" + kExpect + kEnd,
-             1, "unknown attribute 'durationMS' on <Scenario>; did you mean 'durationMs'?"},
+             "<Scenario name=\"t\" topology=\"net.xml\" durationMS=\"3000\">\n" + kExpect + kEnd, 1,
+             "unknown attribute 'durationMS' on <Scenario>; did you mean 'durationMs'?"},
         Case{"cycleUS", Format::kScenario,
              "<Scenario name=\"t\" topology=\"net.xml\" cycleUS=\"500\">\n" + kExpect + kEnd, 1,
              "did you mean 'cycleUs'?"},
@@ -222,8 +236,8 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"Expcet", Format::kScenario,
              scenario("<Expcet>\n<State slave=\"Drive1\" state=\"OP\"/>\n</Expcet>\n"), 2,
              "did you mean <Expect>?"},
-        Case{"Descripton", Format::kScenario, scenario("<Descripton>x</Descripton>\n" + kExpect),
-             2, "did you mean <Description>?"},
+        Case{"Descripton", Format::kScenario, scenario("<Descripton>x</Descripton>\n" + kExpect), 2,
+             "did you mean <Description>?"},
         Case{"knid", Format::kScenario,
              scenario("<Master knid=\"external\" command=\"true\"/>\n" + kExpect), 2,
              "did you mean 'kind'?"},
@@ -231,9 +245,8 @@ INSTANTIATE_TEST_SUITE_P(
              scenario("<Master kind=\"external\" command=\"true\" stopGraceMS=\"10\"/>\n"
                       "<Expect><ExitStatus value=\"0\"/></Expect>\n"),
              2, "did you mean 'stopGraceMs'?"},
-        Case{"two Timelines", Format::kScenario,
-             scenario("<Timeline/>\n<Timeline/>\n" + kExpect), 3,
-             "second <Timeline> in <Scenario> (it takes one)"},
+        Case{"two Timelines", Format::kScenario, scenario("<Timeline/>\n<Timeline/>\n" + kExpect),
+             3, "second <Timeline> in <Scenario> (it takes one)"},
         Case{"atMS", Format::kScenario,
              expect("<State slave=\"Drive1\" state=\"OP\" atMS=\"50\"/>"), 3,
              "unknown attribute 'atMS' on <State>; did you mean 'atMs'?"},
@@ -330,8 +343,8 @@ INSTANTIATE_TEST_SUITE_P(
              timeline("<Action cycle=\"1\" do=\"corrupt\" cable=\"drives\" count=\"1e3\"/>"), 3,
              "corrupt: count=1e3 is not a number in [0, 1000000]"},
         Case{"mailbox-silent on", Format::kScenario,
-             timeline("<Action cycle=\"1\" do=\"mailbox-silent\" slave=\"Drive1\" on=\"yes\"/>"),
-             3, "mailbox-silent: on=yes is not a number in [0, 1]"},
+             timeline("<Action cycle=\"1\" do=\"mailbox-silent\" slave=\"Drive1\" on=\"yes\"/>"), 3,
+             "mailbox-silent: on=yes is not a number in [0, 1]"},
         Case{"input signal", Format::kScenario,
              timeline("<Action cycle=\"1\" do=\"input\" slave=\"Drive1\" channel=\"1\" "
                       "signal=\"sqaure period=1\"/>"),
@@ -352,8 +365,9 @@ INSTANTIATE_TEST_SUITE_P(
                       "durationMs=\"5\" durationCycles=\"5\"/>"),
              3, "delay: takes durationMs=T or durationCycles=N, not both"},
         Case{"pause-master cycles of an external master", Format::kScenario,
-             scenario(kExternal + "<Timeline>\n<Action timeMs=\"1\" do=\"pause-master\" "
-                                  "durationCycles=\"5\"/>\n</Timeline>\n" +
+             scenario(kExternal +
+                      "<Timeline>\n<Action timeMs=\"1\" do=\"pause-master\" "
+                      "durationCycles=\"5\"/>\n</Timeline>\n" +
                       kExpect),
              4, "pause-master: durationCycles needs our master's cycle time"},
         Case{"State cycle and atMs", Format::kScenario,
@@ -391,8 +405,7 @@ INSTANTIATE_TEST_SUITE_P(
              timeline("<Action cycle=\"1\" do=\"power-off\" slave=\"Coupelr\"/>"), 3,
              "no slave 'Coupelr' in the topology; did you mean 'Coupler'?"},
         Case{"topology file", Format::kScenarioFile,
-             "<Scenario name=\"t\" topology=\"nte.xml\">\n" + kExpect + kEnd, 1,
-             "nte.xml"}));
+             "<Scenario name=\"t\" topology=\"nte.xml\">\n" + kExpect + kEnd, 1, "nte.xml"}));
 
 // ---- the master's own configuration file ----------------------------------------------------
 INSTANTIATE_TEST_SUITE_P(
@@ -422,21 +435,22 @@ INSTANTIATE_TEST_SUITE_P(
 // ---- control lines (ecsim ctl and raw clients of the control socket) --------------------------
 INSTANTIATE_TEST_SUITE_P(
     Control, StrictInputs,
-    ::testing::Values(
-        Case{"prot", Format::kControl, "link-down slave=Drive1 prot=1", 0,
-             "link-down: unknown argument 'prot'; did you mean 'port'?"},
-        Case{"ctl durationMS", Format::kControl, "delay cable=drives ns=5 durationMS=10", 0,
-             "did you mean 'durationMs'?"},
-        Case{"link-dwn", Format::kControl, "link-dwn cable=drives", 0,
-             "unknown action 'link-dwn'; did you mean 'link-down'?"},
-        Case{"Link-down", Format::kControl, "Link-down cable=drives", 0,
-             "did you mean 'link-down'?"},
-        Case{"ctl cable", Format::kControlApply, "link-down cable=drivse", 0,
-             "link-down: no cable named 'drivse'; did you mean 'drives'?"},
-        Case{"ctl slave", Format::kControlApply, "power-off slave=Drvie1", 0,
-             "power-off: no slave named 'Drvie1'; did you mean 'Drive1'?"},
-        Case{"ctl state", Format::kControlApply, "al-error slave=Drive1 code=0x1B state=SAFEOPP",
-             0, "did you mean 'SAFEOP'?"}));
+    ::testing::Values(Case{"prot", Format::kControl, "link-down slave=Drive1 prot=1", 0,
+                           "link-down: unknown argument 'prot'; did you mean 'port'?"},
+                      Case{"ctl durationMS", Format::kControl,
+                           "delay cable=drives ns=5 durationMS=10", 0,
+                           "did you mean 'durationMs'?"},
+                      Case{"link-dwn", Format::kControl, "link-dwn cable=drives", 0,
+                           "unknown action 'link-dwn'; did you mean 'link-down'?"},
+                      Case{"Link-down", Format::kControl, "Link-down cable=drives", 0,
+                           "did you mean 'link-down'?"},
+                      Case{"ctl cable", Format::kControlApply, "link-down cable=drivse", 0,
+                           "link-down: no cable named 'drivse'; did you mean 'drives'?"},
+                      Case{"ctl slave", Format::kControlApply, "power-off slave=Drvie1", 0,
+                           "power-off: no slave named 'Drvie1'; did you mean 'Drive1'?"},
+                      Case{"ctl state", Format::kControlApply,
+                           "al-error slave=Drive1 code=0x1B state=SAFEOPP", 0,
+                           "did you mean 'SAFEOP'?"}));
 
 // The strict readers take every file the project ships: its topologies, its scenarios (with our
 // master and external ones) checked against their topologies.

@@ -20,6 +20,7 @@
 #include "link/tap_link.hpp"
 #include "link/veth_setup.hpp"
 #include "slavesim/generic_slave.hpp"
+#include "tools/common/install_paths.hpp"
 #include "tools/ecsim/commands.hpp"
 #include "tools/ecsim/control_api.hpp"
 #include "tools/ecsim/status_view.hpp"
@@ -29,7 +30,6 @@
 #include "topology/network_from_eni.hpp"
 #include "topology/network_server.hpp"
 #include "topology/pcap_cable_tap.hpp"
-#include "tools/common/install_paths.hpp"
 
 namespace ecsim::tools {
 namespace {
@@ -44,6 +44,7 @@ struct ServeOptions {
   std::string esiDir;  // ESI files for an ENI's devices; empty: the data folder's esi/
   std::vector<std::string> pcapLinks;  // NAME=FILE
   std::string iface;
+  std::string redundantIface;  // the master's second port (cable redundancy)
   std::string veth;
   std::string tap;
   std::string netns;
@@ -88,7 +89,23 @@ int runServe(ServeOptions o) {
     o.iface = pair->simulatorInterface;
     fmt::print("ecsim: veth pair ready, point your master at {}\n", pair->masterInterface);
   }
+  if (!o.redundantIface.empty() && o.iface.empty()) {
+    fmt::print(stderr, "ecsim serve: --redundant-iface needs --iface or --veth\n");
+    return 2;
+  }
   std::unique_ptr<Link> link;
+  std::unique_ptr<Link> redundantLink;
+  if (!o.redundantIface.empty()) {
+    auto raw = RawSocketLink::open(
+        o.redundantIface,
+        RawSocketOptions{
+            .netns = o.netns, .promiscuous = true, .qdiscBypass = true, .busyPoll = o.busyPoll});
+    if (!raw.ok()) {
+      fmt::print(stderr, "ecsim serve: {}\n", raw.error().message());
+      return 1;
+    }
+    redundantLink = std::make_unique<RawSocketLink>(std::move(raw).value());
+  }
   if (!o.iface.empty()) {
     auto raw = RawSocketLink::open(
         o.iface,
@@ -156,6 +173,20 @@ int runServe(ServeOptions o) {
   // What the ENI reader ignored and what building the devices could not take as written.
   for (const auto& w : network.warnings) fmt::print(stderr, "ecsim serve: warning: {}\n", w);
   topology::Segment& segment = *network.segment;
+  if (redundantLink != nullptr && !segment.redundant()) {
+    fmt::print(stderr,
+               "ecsim serve: --redundant-iface: the topology has no redundant port (<Master "
+               "redundant=\"SLAVE:PORT\">, docs/topology.md)\n");
+    return 2;
+  }
+  if (redundantLink == nullptr && segment.redundant()) {
+    fmt::print(stderr,
+               "ecsim serve: warning: the topology's redundant port has no master port "
+               "(--redundant-iface): the ring is open there\n");
+  }
+  if (redundantLink != nullptr) {  // the master's second port is there: its link comes up
+    segment.setLinkUp(segment.redundantSlave(), segment.redundantPortNumber(), true);
+  }
 
   RealClock clock;
   // Captures are stamped with model time; model time 0 is mapped to the Unix time now.
@@ -220,9 +251,11 @@ int runServe(ServeOptions o) {
   // came back to back, and a scan timed out (StudyLatencyVeth, DriveVeth, SOEM v2 simple_ng).
   options.malformedObserver = malformedTap;
   topology::NetworkServer server(*served, segment, clock, options);
+  server.setRedundantLink(redundantLink.get());
   SignalFlag stop;
   if (!o.quiet) {
-    fmt::print("ecsim: serving {} slave(s) on {}{}\n", segment.size(), link->describe(),
+    fmt::print("ecsim: serving {} slave(s) on {}{}{}\n", segment.size(), link->describe(),
+               redundantLink ? " and, redundant, " + redundantLink->describe() : std::string(),
                o.pcap.empty() ? "" : fmt::format(", capturing to {}", o.pcap));
     std::fflush(stdout);
   }
@@ -304,6 +337,9 @@ CommandRunner addServeCommand(CLI::App& app) {
                   "Folder of ESI files for an ENI's devices (default: the examples' esi/)");
   cmd->add_option("--pcap-link", opts->pcapLinks, "Capture the cable NAME to FILE (NAME=FILE)");
   cmd->add_option("--iface", opts->iface, "Interface to serve (e.g. one end of a veth pair)");
+  cmd->add_option("--redundant-iface", opts->redundantIface,
+                  "The master's second port (cable redundancy: the topology's <Master "
+                  "redundant=>)");
   cmd->add_option("--veth", opts->veth, "Create veth pair NAME for this run (master end NAME)");
   cmd->add_option("--tap", opts->tap, "Create/open this TAP device and serve on it");
   cmd->add_option("--netns", opts->netns, "Open the interface inside this network namespace");
@@ -312,8 +348,9 @@ CommandRunner addServeCommand(CLI::App& app) {
   cmd->add_option("--pcap", opts->pcap, "Capture every frame to this pcap file");
   cmd->add_option("--pcap-malformed", opts->pcapMalformed,
                   "Capture the malformed frames the simulator dropped to this pcap file");
-  cmd->add_option("--control", opts->control,
-                  "Control socket for queries and live fault injection (default /run/ecsim/IFACE.sock)");
+  cmd->add_option(
+      "--control", opts->control,
+      "Control socket for queries and live fault injection (default /run/ecsim/IFACE.sock)");
   cmd->add_flag("--paced", opts->paced, "Answer at the modelled round-trip time");
   cmd->add_flag("--quiet", opts->quiet, "Print only the final statistics");
   cmd->add_flag("--rt", opts->realtime, "Run with SCHED_FIFO priority and locked memory");
