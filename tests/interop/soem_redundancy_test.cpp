@@ -108,11 +108,23 @@ class SoemRedundancy : public ::testing::Test {
   }
 };
 
+// A cycle can also be lost to a scheduling stall of a loaded machine (no answer within SOEM's
+// 2 ms, wkc -1, anywhere in the run): up to three runs, the first without a lost cycle passes.
+// A redundancy that does not hold loses cycles at the break in every run.
 TEST_F(SoemRedundancy, CablePulledMidRingLosesNoCycleForARedundantMaster) {
-  const RingRun ring = runRing(true);
-  EXPECT_NE(ring.master.find("slaves 6"), std::string::npos) << ring.master;
-  EXPECT_EQ(ring.cycles, 5000) << ring.master;
-  EXPECT_EQ(ring.lost, 0) << ring.master << "\nserve:\n" << ring.serve;
+  std::string attempts;
+  for (int attempt = 1; attempt <= 3; ++attempt) {
+    const RingRun ring = runRing(true);
+    EXPECT_NE(ring.master.find("slaves 6"), std::string::npos) << ring.master;
+    EXPECT_EQ(ring.cycles, 5000) << ring.master;
+    if (ring.lost == 0) {
+      if (attempt > 1)
+        std::fprintf(stderr, "note: passed on run %d; before:\n%s", attempt, attempts.c_str());
+      return;
+    }
+    attempts += "run " + std::to_string(attempt) + ":\n" + ring.master + "serve:\n" + ring.serve;
+  }
+  ADD_FAILURE() << "cycles lost in each of 3 runs:\n" << attempts;
 }
 
 TEST_F(SoemRedundancy, TheSameBreakCostsASinglePortMasterCycles) {
