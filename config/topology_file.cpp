@@ -73,7 +73,9 @@ Result<std::optional<std::int64_t>> attrInteger(const xml::Context& ctx, const E
 constexpr std::string_view kCableWhy = " m (the 100BASE-TX segment limit)";
 
 // What each element takes (docs/topology.md); anything else is an error (xml::checkNames).
-const xml::Names kTopologyNames{{"name"}, {"Master", "Slave", "Link", "Eni"}, {"Master", "Eni"}};
+const xml::Names kTopologyNames{
+    {"name"}, {"Master", "Slave", "Link", "Eni", "Group"}, {"Master", "Eni"}};
+const xml::Names kGroupNames{{"name", "slaves", "attached"}};
 // <Eni file= esiDir=>: the slaves and wiring of an ENI; its <Slave> elements name ENI slaves and
 // carry only behaviour (model, parameters, inputs, state file).
 const xml::Names kEniNames{{"file", "esiDir"}};
@@ -304,6 +306,79 @@ Status checkWiring(const xml::Context& ctx, const TopologyConfig& cfg) {
   return okStatus();
 }
 
+// <Group name="Tool" slaves="T1 T2" attached="true">: after the wiring is known (its junction
+// link is the one link between a member and a slave outside).
+Status parseGroups(const xml::Context& ctx, const Element* root, TopologyConfig& cfg) {
+  std::map<std::size_t, std::string> memberOf;  // slave -> its group
+  std::vector<std::string_view> names;
+  for (const auto& slave : cfg.slaves) names.push_back(slave.name);
+  for (const Element* e : xml::Children(root, "Group")) {
+    ECSIM_TRY(xml::checkNames(ctx, e, kGroupNames));
+    TopologyGroup g;
+    g.line = e->GetLineNum();
+    const char* name = e->Attribute("name");
+    const char* slaves = e->Attribute("slaves");
+    if (name == nullptr || *name == '\0') return ctx.error(e, "Group needs attribute 'name'");
+    if (slaves == nullptr) return ctx.error(e, "Group needs attribute 'slaves' (names)");
+    g.name = name;
+    for (const auto& other : cfg.groups) {
+      if (other.name == g.name) {
+        return ctx.error(
+            e, fmt::format("group name '{}' given twice (first on line {})", g.name, other.line));
+      }
+    }
+    if (const char* attached = e->Attribute("attached")) {
+      const std::string_view a(attached);
+      if (a != "true" && a != "false") {
+        return ctx.error(e, fmt::format("attached: '{}' is not true or false", a));
+      }
+      g.attached = a == "true";
+    }
+    std::string_view list(slaves);
+    while (!list.empty()) {
+      const auto start = list.find_first_not_of(" ,");
+      if (start == std::string_view::npos) break;
+      list.remove_prefix(start);
+      const std::string_view member = list.substr(0, list.find_first_of(" ,"));
+      list.remove_prefix(member.size());
+      auto index = cfg.findSlave(member);
+      if (!index) {
+        return ctx.error(
+            e, fmt::format("slaves: no slave named '{}'{}", member, didYouMean(member, names)));
+      }
+      if (*index == 0) {
+        return ctx.error(e, fmt::format("slaves: '{}' is the slave at the master; a group is "
+                                        "attached behind another slave",
+                                        member));
+      }
+      if (auto [it, fresh] = memberOf.emplace(*index, g.name); !fresh) {
+        return ctx.error(e,
+                         fmt::format("slaves: '{}' is in group '{}' already", member, it->second));
+      }
+      g.slaves.push_back(*index);
+    }
+    if (g.slaves.empty()) return ctx.error(e, "slaves: a group needs at least one slave");
+    auto member = [&](std::size_t s) {
+      return std::find(g.slaves.begin(), g.slaves.end(), s) != g.slaves.end();
+    };
+    std::optional<std::size_t> junction;
+    for (std::size_t i = 0; i < cfg.links.size(); ++i) {
+      const auto& l = cfg.links[i];
+      if (member(l.fromSlave) == member(l.toSlave)) continue;
+      if (junction) {
+        return ctx.error(e, fmt::format("group '{}' is joined to the rest by two links ('{}' and "
+                                        "'{}'): a group hangs from one junction port",
+                                        g.name, cfg.links[*junction].name, l.name));
+      }
+      junction = i;
+    }
+    if (!junction) return ctx.error(e, fmt::format("group '{}' has no link to the rest", g.name));
+    g.junctionLink = *junction;
+    cfg.groups.push_back(std::move(g));
+  }
+  return okStatus();
+}
+
 }  // namespace
 
 std::optional<std::size_t> TopologyConfig::findSlave(std::string_view n) const {
@@ -348,6 +423,7 @@ Result<TopologyConfig> parseTopology(std::string_view text, const std::filesyste
     onEni.file = file;
     onEni.name = cfg.name.empty() ? onEni.name : cfg.name;
     onEni.masterCableMetres = cfg.masterCableMetres;
+    ECSIM_TRY(parseGroups(ctx, root, onEni));  // groups of ENI slaves, on the ENI's wiring
     return onEni;
   }
   for (const Element* e : xml::Children(root, "Slave")) {
@@ -403,6 +479,7 @@ Result<TopologyConfig> parseTopology(std::string_view text, const std::filesyste
                cfg.slaves[l.toSlave].name + ":" + std::to_string(l.toPort);
   }
   ECSIM_TRY(checkWiring(ctx, cfg));
+  ECSIM_TRY(parseGroups(ctx, root, cfg));
   return cfg;
 }
 

@@ -84,6 +84,17 @@ struct TopologyLink {
   int line{0};
 };
 
+// A hot-connect group (<Group name= slaves= attached=>): slaves attached to and detached from
+// the running network together (a tool changer), through the one link that joins them to the
+// rest (the junction's cable).
+struct TopologyGroup {
+  std::string name;
+  std::vector<std::size_t> slaves;  // slave indices, as written
+  bool attached{true};              // at power-up
+  std::size_t junctionLink{0};      // index in TopologyConfig::links
+  int line{0};
+};
+
 struct TopologyConfig {
   std::string name;
   std::filesystem::path file;
@@ -95,6 +106,7 @@ struct TopologyConfig {
   int masterLine{0};
   std::vector<TopologySlave> slaves;  // in the order written; slave 0 is at the master
   std::vector<TopologyLink> links;    // empty in the file: a line in written order
+  std::vector<TopologyGroup> groups;  // hot-connect groups
   bool explicitLinks{false};
   // Slave index by name, filled by parseTopology (findSlave falls back to a search when a
   // caller filled `slaves` itself).

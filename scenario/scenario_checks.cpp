@@ -54,6 +54,9 @@ Status checkTopologyNames(const Scenario& s, const TopologyConfig& topology) {
   for (const auto& slave : topology.slaves) slaves.push_back(slave.name);
   std::vector<std::string_view> cables{"master"};
   for (const auto& link : topology.links) cables.push_back(link.name);
+  if (topology.redundantPort) cables.push_back("redundant");
+  std::vector<std::string_view> groups;
+  for (const auto& g : topology.groups) groups.push_back(g.name);
   auto check = [&](int line, std::string_view what, std::string_view name,
                    const std::vector<std::string_view>& names) -> Status {
     if (std::find(names.begin(), names.end(), name) != names.end()) return okStatus();
@@ -64,6 +67,7 @@ Status checkTopologyNames(const Scenario& s, const TopologyConfig& topology) {
   for (const auto& a : s.actions) {
     if (auto slave = a.action.get("slave")) ECSIM_TRY(check(a.line, "slave", *slave, slaves));
     if (auto cable = a.action.get("cable")) ECSIM_TRY(check(a.line, "cable", *cable, cables));
+    if (auto group = a.action.get("group")) ECSIM_TRY(check(a.line, "group", *group, groups));
   }
   for (const auto& x : s.expectations) {
     if (!x.slave.empty()) ECSIM_TRY(check(x.line, "slave", x.slave, slaves));
@@ -75,8 +79,8 @@ Status checkVariableNames(const Scenario& s, const std::vector<master::VariableI
   for (const auto& x : s.expectations) {
     if (x.kind != ExpectKind::kVariable || x.variable.empty()) continue;
     if (auto v = master::findVariable(variables, x.variable); !v.ok()) {
-      return makeError(ErrorCode::kNotFound, fmt::format("{}, line {}: {}", s.file.string(),
-                                                         x.line, v.error().context));
+      return makeError(ErrorCode::kNotFound,
+                       fmt::format("{}, line {}: {}", s.file.string(), x.line, v.error().context));
     }
   }
   return okStatus();

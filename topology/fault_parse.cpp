@@ -22,7 +22,7 @@ struct VerbArguments {
   std::array<std::string_view, kMaxVerbKeys> keys;
   bool scenarioOnly{false};
 };
-constexpr std::array<VerbArguments, 19> kVerbArguments{{
+constexpr std::array<VerbArguments, 21> kVerbArguments{{
     {"loss", {"cable", "rate"}},
     {"corrupt", {"cable", "count", "port", "slave"}},
     {"delay", {"cable", "durationCycles", "durationMs", "ns", "port", "slave"}},
@@ -31,6 +31,8 @@ constexpr std::array<VerbArguments, 19> kVerbArguments{{
     {"power-off", {"slave"}},
     {"power-on", {"slave"}},
     {"power-cycle", {"slave"}},
+    {"attach", {"group"}},
+    {"detach", {"group"}},
     {"al-error", {"code", "slave", "state"}},
     {"eeprom-checksum", {"slave"}},
     {"mailbox-silent", {"on", "slave"}},
@@ -330,6 +332,10 @@ Result<Fault> parseFault(const FaultAction& a, const FaultContext& context) {
     if (v == "link-up") return Fault{LinkUp{at}};
     return Fault{LinkDown{at}};
   }
+  if (v == "attach" || v == "detach") {
+    ECSIM_ASSIGN_OR_RETURN(auto group, a.require("group"));
+    return Fault{HotConnect{std::string(group), v == "attach"}};
+  }
   if (v == "pause-master") {
     PauseMaster f;
     ECSIM_ASSIGN_OR_RETURN(f.duration, durationArgument(a, context));
@@ -427,6 +433,7 @@ struct VerbOf {
   std::string_view operator()(const PowerOff&) const { return "power-off"; }
   std::string_view operator()(const PowerOn&) const { return "power-on"; }
   std::string_view operator()(const PowerCycle&) const { return "power-cycle"; }
+  std::string_view operator()(const HotConnect& f) const { return f.attach ? "attach" : "detach"; }
   std::string_view operator()(const AlError&) const { return "al-error"; }
   std::string_view operator()(const EepromChecksum&) const { return "eeprom-checksum"; }
   std::string_view operator()(const MailboxSilent& f) const {
@@ -461,6 +468,7 @@ struct Arguments {
   std::string operator()(const PowerOff& f) const { return "slave=" + argText(f.slave); }
   std::string operator()(const PowerOn& f) const { return "slave=" + argText(f.slave); }
   std::string operator()(const PowerCycle& f) const { return "slave=" + argText(f.slave); }
+  std::string operator()(const HotConnect& f) const { return "group=" + argText(f.group); }
   std::string operator()(const AlError& f) const {
     return fmt::format("slave={} code={:#06x}", argText(f.slave), f.code) +
            (f.state ? " state=" + std::string(nameOf(*f.state, kStates)) : "");

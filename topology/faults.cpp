@@ -18,8 +18,6 @@ namespace {
 constexpr std::size_t kSiiChecksumByte = 14;  // word 7, low byte: CRC-8 of words 0-6
 constexpr std::uint16_t kPositionSensorFault = 0x7305;
 
-
-
 // Wraps a slave's mailbox server: silent (requests swallowed, nothing answered) or aborting
 // SDO requests for chosen objects with a chosen code; everything else goes to the real server.
 class FaultyMailbox final : public slavesim::MailboxServer {
@@ -226,8 +224,7 @@ Result<std::string> FaultInjector::apply(const Fault& fault, SimTime now, std::s
   auto done = std::visit([&](const auto& f) { return on(f, now); }, fault);
   if (done.ok()) return done;
   return makeError(done.error().code, (where.empty() ? std::string() : std::string(where) + ": ") +
-                                          std::string(verbOf(fault)) + ": " +
-                                          done.error().context);
+                                          std::string(verbOf(fault)) + ": " + done.error().context);
 }
 
 Result<std::string> FaultInjector::on(const Loss& f, SimTime /*now*/) {
@@ -271,9 +268,9 @@ Result<std::string> FaultInjector::on(const Delay& f, SimTime now) {
   if (f.extra == 0) return std::string("delay spikes on the cable removed");
   if (f.duration == 0) return std::string("no delay: duration 0");
   if (spikes_.size() >= kMaxDelaySpikes) {
-    return fail(fmt::format(
-        "{} delay spikes are active, the most at once (ns=0 removes a cable's spikes)",
-        spikes_.size()));
+    return fail(
+        fmt::format("{} delay spikes are active, the most at once (ns=0 removes a cable's spikes)",
+                    spikes_.size()));
   }
   spikes_.push_back({end, f.extra, saturatingAdd(now, f.duration)});
   refreshAny();
@@ -290,8 +287,8 @@ Result<std::string> FaultInjector::setLink(const FaultPlace& at, bool up) {
     cablesDown_.insert(end);
   }
   setCable(end, up);
-  return fmt::format("link {} at {} port {}", up ? "up" : "down",
-                     segment_.slave(end.slave).name(), end.port);
+  return fmt::format("link {} at {} port {}", up ? "up" : "down", segment_.slave(end.slave).name(),
+                     end.port);
 }
 
 Result<std::string> FaultInjector::on(const LinkDown& f, SimTime /*now*/) {
@@ -344,6 +341,29 @@ Result<std::string> FaultInjector::on(const PowerCycle& f, SimTime now) {
   ECSIM_ASSIGN_OR_RETURN(auto s, slaveNamed(f.slave));
   if (auto off = powerOff(s); !off.ok()) return off.takeError();
   return powerOn(s, now);
+}
+
+// Detached, a group's slaves are without power as a tool taken off its changer is: the
+// junction's port loses its link (and its ESC closes it), the rest of the network runs on.
+// Attached again they power up (INIT, station address 0, EEPROM loaded) for the master to find.
+Result<std::string> FaultInjector::on(const HotConnect& f, SimTime now) {
+  const auto group = std::find_if(network_.groups.begin(), network_.groups.end(),
+                                  [&](const HotConnectGroup& g) { return g.name == f.group; });
+  if (group == network_.groups.end()) {
+    std::vector<std::string_view> names;
+    for (const auto& g : network_.groups) names.push_back(g.name);
+    return fail("no group named '" + f.group + "'" + didYouMean(f.group, names) +
+                (names.empty() ? " (the topology has no <Group>)" : ""));
+  }
+  for (const std::size_t s : group->slaves) {
+    if (f.attach) {
+      if (auto on = powerOn(s, now); !on.ok()) return on.takeError();
+    } else if (segment_.slave(s).powered()) {
+      if (auto off = powerOff(s); !off.ok()) return off.takeError();
+    }
+  }
+  return fmt::format("group {} {} ({} slave(s))", f.group, f.attach ? "attached" : "detached",
+                     group->slaves.size());
 }
 
 Result<std::string> FaultInjector::on(const AlError& f, SimTime /*now*/) {
@@ -436,7 +456,8 @@ Result<std::string> FaultInjector::on(const EncoderFault& f, SimTime /*now*/) {
                        f.on ? "fault" : "fault cleared");
   }
   auto* drive = slavesim::devices::driveOf(slave);
-  if (drive == nullptr) return fail(slave.name() + " is neither an encoder terminal nor a CiA 402 drive");
+  if (drive == nullptr)
+    return fail(slave.name() + " is neither an encoder terminal nor a CiA 402 drive");
   drive->injectFault(kPositionSensorFault);
   return fmt::format("{}: drive fault {:#06x}", slave.name(), kPositionSensorFault);
 }

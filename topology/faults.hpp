@@ -11,6 +11,8 @@
 //   power-off|power-on slave=S      off: a broken link at the neighbours' ports; on: power-on
 //                                   reset (registers, AL state, dictionary values, device
 //                                   model; EEPROM and encoder position kept)
+//   detach|attach group=G           a hot-connect group (topology <Group>): its slaves off,
+//                                   the junction's port without link / on again
 //   al-error slave=S code=X [state=SAFEOP]   the firmware raises a local error
 //   eeprom-checksum slave=S         corrupts the SII checksum (word 7) and power-cycles
 //   mailbox-silent slave=S [on=0|1] the mailbox server stops (or resumes) answering
@@ -169,6 +171,12 @@ struct PowerOn {
 struct PowerCycle {
   std::string slave;
 };
+// A hot-connect group (topology <Group>) detached (its slaves lose power, the junction's port
+// its link) or attached again (power on: INIT, station address 0, EEPROM reloaded).
+struct HotConnect {
+  std::string group;
+  bool attach{true};
+};
 struct AlError {
   std::string slave;
   std::uint16_t code{0};
@@ -216,8 +224,8 @@ struct PauseMaster {  // scenarios: carried out by the runner, not by FaultInjec
   SimTime duration{0};
 };
 using Fault = std::variant<LinkDown, LinkUp, Loss, Corrupt, Delay, PowerOff, PowerOn, PowerCycle,
-                           AlError, EepromChecksum, MailboxSilent, SdoAbortFault, SdoOk, DriveFault,
-                           EncoderFault, Input, Latch, PauseMaster>;
+                           HotConnect, AlError, EepromChecksum, MailboxSilent, SdoAbortFault, SdoOk,
+                           DriveFault, EncoderFault, Input, Latch, PauseMaster>;
 
 // What parseFault needs besides the action: where it is written and, for durationCycles, the
 // cycle time of the master that counts the cycles (0: none known, durationCycles refused).
@@ -284,6 +292,7 @@ class FaultInjector final : public WireFaults {
   Result<std::string> on(const PowerOff& f, SimTime now);
   Result<std::string> on(const PowerOn& f, SimTime now);
   Result<std::string> on(const PowerCycle& f, SimTime now);
+  Result<std::string> on(const HotConnect& f, SimTime now);
   Result<std::string> on(const AlError& f, SimTime now);
   Result<std::string> on(const EepromChecksum& f, SimTime now);
   Result<std::string> on(const MailboxSilent& f, SimTime now);

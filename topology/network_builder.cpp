@@ -336,6 +336,15 @@ Result<Network> buildNetwork(const TopologyConfig& config) {
     }
     net.cables.push_back({"redundant", slave, port});
   }
+  // A group detached at power-up: its slaves are off, so the junction's port has no link.
+  for (const auto& g : config.groups) {
+    net.groups.push_back({g.name, g.slaves});
+    if (g.attached) continue;
+    for (const std::size_t s : g.slaves) seg.slave(s).powerOff();
+    const TopologyLink& j = config.links[g.junctionLink];
+    seg.setLinkUp(j.fromSlave, j.fromPort, false);
+    seg.setLinkUp(j.toSlave, j.toPort, false);
+  }
   net.warnings.insert(net.warnings.end(), config.warnings.begin(), config.warnings.end());
   net.warnings.insert(net.warnings.end(), factory.warnings().begin(), factory.warnings().end());
   return net;

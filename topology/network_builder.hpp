@@ -22,9 +22,16 @@ struct CableRef {
   unsigned port{0};
 };
 
+// A hot-connect group (docs/topology.md): its slaves, attached and detached together.
+struct HotConnectGroup {
+  std::string name;
+  std::vector<std::size_t> slaves;
+};
+
 struct Network {
   std::unique_ptr<Segment> segment;
   std::vector<CableRef> cables;  // "master" first (slave 0, port 0), then the file's links
+  std::vector<HotConnectGroup> groups;
   // Values a tolerant reader ignored ("file, line N: ..."; e.g. an ENI's absurd cycle time),
   // for the tool to show.
   std::vector<std::string> warnings;

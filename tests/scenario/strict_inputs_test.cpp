@@ -54,6 +54,7 @@ const std::string kNet =
     "  <Slave name=\"Drive2\"/>\n"
     "  <Link name=\"drives\" from=\"Coupler:1\" to=\"Drive1:0\"/>\n"
     "  <Link from=\"Drive1:1\" to=\"Drive2:0\"/>\n"
+    "  <Group name=\"Tool\" slaves=\"Drive2\"/>\n"
     "</Topology>\n";
 
 // Line 1 of every scenario row; 100 cycles of 1 ms.
@@ -158,6 +159,19 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"Master cabel", Format::kTopology,
              "<Topology>\n<Master cabel=\"20\"/>\n<Slave name=\"A\"/>\n</Topology>\n", 2,
              "unknown attribute 'cabel' on <Master>; did you mean 'cable'?"},
+        Case{"Group slave", Format::kTopology,
+             "<Topology>\n<Slave name=\"A\"/>\n<Slave name=\"B\"/>\n"
+             "<Group name=\"T\" slave=\"B\"/>\n</Topology>\n",
+             4, "unknown attribute 'slave' on <Group>; did you mean 'slaves'?"},
+        Case{"Group member", Format::kTopology,
+             "<Topology>\n<Slave name=\"A\"/>\n<Slave name=\"Tool1\"/>\n"
+             "<Group name=\"T\" slaves=\"Tol1\"/>\n</Topology>\n",
+             4, "slaves: no slave named 'Tol1'; did you mean 'Tool1'?"},
+        // A group hangs from one junction port: B-C inside, A-B and C-D both leave it.
+        Case{"Group two junctions", Format::kTopology,
+             "<Topology>\n<Slave name=\"A\"/>\n<Slave name=\"B\"/>\n<Slave name=\"C\"/>\n"
+             "<Slave name=\"D\"/>\n<Group name=\"T\" slaves=\"B C\"/>\n</Topology>\n",
+             6, "group 'T' is joined to the rest by two links"},
         Case{"Master redundnat", Format::kTopology,
              "<Topology>\n<Master redundnat=\"A:1\"/>\n<Slave name=\"A\"/>\n</Topology>\n", 2,
              "unknown attribute 'redundnat' on <Master>; did you mean 'redundant'?"},
@@ -395,6 +409,11 @@ INSTANTIATE_TEST_SUITE_P(
         Case{"expectation slave", Format::kScenarioFile,
              expect("<State slave=\"Drvie1\" state=\"OP\"/>"), 3,
              "no slave 'Drvie1' in the topology; did you mean 'Drive1'?"},
+        Case{"action group", Format::kScenarioFile,
+             timeline("<Action cycle=\"1\" do=\"detach\" group=\"Tol\"/>"), 3,
+             "no group 'Tol' in the topology; did you mean 'Tool'?"},
+        Case{"control group", Format::kControlApply, "attach group=tool", 0,
+             "no group named 'tool'; did you mean 'Tool'?"},
         Case{"detected slave", Format::kScenarioFile,
              expect("<Detected condition=\"slave-lost\" slave=\"drive2\" withinCycles=\"5\"/>"), 3,
              "did you mean 'Drive2'?"},
