@@ -229,14 +229,13 @@ Result<std::vector<std::vector<std::uint8_t>>> fragmentEoeFrame(ConstBytes frame
                                                                 std::uint8_t port,
                                                                 std::uint8_t frameNumber) {
   if (frame.empty() || frame.size() > kEoeMaxFrameSize) {
-    return makeError(ErrorCode::kInvalidArgument,
-                     "EoE frame of " + std::to_string(frame.size()) + " bytes (1.." +
-                         std::to_string(kEoeMaxFrameSize) + ")");
+    return makeError(ErrorCode::kInvalidArgument, "EoE frame of " + std::to_string(frame.size()) +
+                                                      " bytes (1.." +
+                                                      std::to_string(kEoeMaxFrameSize) + ")");
   }
-  const std::size_t room =
-      mailboxSize > kMailboxHeaderSize + kEoeHeaderSize
-          ? mailboxSize - kMailboxHeaderSize - kEoeHeaderSize
-          : 0;
+  const std::size_t room = mailboxSize > kMailboxHeaderSize + kEoeHeaderSize
+                               ? mailboxSize - kMailboxHeaderSize - kEoeHeaderSize
+                               : 0;
   const std::size_t chunk = room / kEoeFragmentUnit * kEoeFragmentUnit;
   if (chunk == 0) {
     return makeError(ErrorCode::kTooLarge, "a mailbox of " + std::to_string(mailboxSize) +
@@ -292,8 +291,8 @@ Result<std::optional<std::vector<std::uint8_t>>> EoeReassembler::add(const EoeHe
       problem = "fragment of frame " + std::to_string(h.frameNumber) + " inside frame " +
                 std::to_string(frameNumber_);
     } else if (static_cast<std::size_t>(h.offsetUnits) * kEoeFragmentUnit != frame_.size()) {
-      problem = "fragment offset " + std::to_string(h.offsetUnits * kEoeFragmentUnit) +
-                " where " + std::to_string(frame_.size()) + " was due";
+      problem = "fragment offset " + std::to_string(h.offsetUnits * kEoeFragmentUnit) + " where " +
+                std::to_string(frame_.size()) + " was due";
     }
     if (!problem.empty()) {
       reset();

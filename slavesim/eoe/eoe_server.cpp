@@ -20,7 +20,11 @@ void padFrame(std::vector<std::uint8_t>& frame) {
 MacAddress EoeServer::mac(const Esc& esc) const {
   if (ip_.mac) return *ip_.mac;
   const std::uint16_t station = esc.stationAddress();
-  return MacAddress{kLocalMacPrefix, 0, 0, 0, static_cast<std::uint8_t>(station >> 8),
+  return MacAddress{kLocalMacPrefix,
+                    0,
+                    0,
+                    0,
+                    static_cast<std::uint8_t>(station >> 8),
                     static_cast<std::uint8_t>(station)};
 }
 
@@ -64,8 +68,7 @@ void EoeServer::onMessage(Esc& esc, const MailboxMessage& message, MailboxReplie
       ++counters_.setIpRequests;
       auto update = EoeIpParameters::decode(body);
       if (!update.ok()) {
-        answer(replies, EoeFrameType::kSetIpResponse, header->port,
-               EoeResult::kUnspecifiedError);
+        answer(replies, EoeFrameType::kSetIpResponse, header->port, EoeResult::kUnspecifiedError);
         break;
       }
       ip_.merge(*update);

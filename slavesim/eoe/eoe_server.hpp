@@ -31,8 +31,8 @@
 namespace ecsim::slavesim::eoe {
 
 struct EoeServerOptions {
-  bool loopback{false};               // frames not for the device's stack return to the master
-  std::size_t maxPendingFrames{32};   // frames waiting for the mailbox; more are dropped
+  bool loopback{false};              // frames not for the device's stack return to the master
+  std::size_t maxPendingFrames{32};  // frames waiting for the mailbox; more are dropped
 };
 
 struct EoeServerCounters {
@@ -68,6 +68,8 @@ class EoeServer final : public MailboxProtocol {
   void setIpParameters(const EoeIpParameters& update) { ip_.merge(update); }
   // The MAC the device answers with (the configured one, else the station-derived one).
   MacAddress mac(const Esc& esc) const;
+
+  void setLoopback(bool on) { options_.loopback = on; }
 
   // Frames leaving the device's Ethernet port (not taken by its own stack) go here.
   void setFrameSink(FrameSink sink) { sink_ = std::move(sink); }

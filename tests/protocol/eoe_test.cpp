@@ -21,7 +21,7 @@ std::vector<std::uint8_t> soemSetIpRequest() {
   m[0] = 62;
   m[5] = 0x12;  // EoE, counter 1
   m[6] = 0x02;
-  m[7] = 0x01;  // type 2, last fragment
+  m[7] = 0x01;   // type 2, last fragment
   m[10] = 0x0E;  // flags
   const std::uint8_t ip[] = {0xC8, 0x09, 0xA8, 0xC0};
   const std::uint8_t mask[] = {0x00, 0xFF, 0xFF, 0xFF};

@@ -7,6 +7,7 @@
 #include <numeric>
 
 #include "protocol/eoe.hpp"
+#include "slavesim/eoe/eoe_params.hpp"
 #include "slavesim/eoe/eoe_server.hpp"
 #include "tests/slavesim/coe_test_support.hpp"
 
@@ -241,6 +242,31 @@ TEST(EoeServer, DropsABrokenFragmentSequenceAndTakesTheNextFrame) {
   auto reply = s.receiveFrame();
   ASSERT_TRUE(reply);
   EXPECT_EQ(s.eoe->counters().echoReplies, 1u);
+}
+
+TEST(EoeParams, TopologyParamsSetTheIpAndNameABadOneWithItsLine) {
+  EoeSlave s;
+  ASSERT_TRUE(slavesim::eoe::applyEoeParams(*s.eoe, {{"eoe.ip", "192.168.9.200", 3},
+                                                     {"eoe.mac", "02:00:00:00:00:2a", 4},
+                                                     {"eoe.name", "drive1", 5}})
+                  .ok());
+  // Get IP answers what the file said, without any Set IP from a master.
+  auto [h, body] = s.request(EoeFrameType::kGetIpRequest, {});
+  auto got = EoeIpParameters::decode(body);
+  ASSERT_TRUE(got.ok());
+  EXPECT_EQ(got->ip, kSlaveIp);
+  EXPECT_EQ(got->mac, (MacAddress{2, 0, 0, 0, 0, 0x2a}));
+  EXPECT_EQ(got->dnsName, "drive1");
+
+  auto typo = slavesim::eoe::applyEoeParams(*s.eoe, {{"eoe.gatway", "10.0.0.1", 7}});
+  ASSERT_FALSE(typo.ok());
+  EXPECT_NE(typo.error().context.find("line 7"), std::string::npos) << typo.error().context;
+  EXPECT_NE(typo.error().context.find("did you mean 'eoe.gateway'"), std::string::npos)
+      << typo.error().context;
+  auto bad = slavesim::eoe::applyEoeParams(*s.eoe, {{"eoe.mask", "255.255.0", 9}});
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().context.find("line 9: eoe.mask"), std::string::npos)
+      << bad.error().context;
 }
 
 }  // namespace
