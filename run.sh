@@ -10,7 +10,7 @@ packages=(
   build-essential cmake ninja-build g++ clang libclang-rt-14-dev pkg-config
   libgtest-dev libgmock-dev libbenchmark-dev
   libtinyxml2-dev libpcap-dev libcli11-dev libfmt-dev libspdlog-dev nlohmann-json3-dev
-  libeigen3-dev libre2-dev tshark gnuplot-nox iproute2 ethtool procps libxml2-utils
+  libeigen3-dev libre2-dev tshark gnuplot-nox iproute2 iputils-ping ethtool procps libxml2-utils
   file dpkg-dev pybind11-dev python3-dev python3-pytest
 )
 

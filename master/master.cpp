@@ -379,6 +379,24 @@ Status Master::sdoDownload(std::size_t position, std::uint16_t index, std::uint8
   return task.status();
 }
 
+Status Master::eoeSetIp(std::size_t position, const EoeIpParameters& parameters,
+                        std::uint8_t port) {
+  ECSIM_ASSIGN_OR_RETURN(SlaveInfo * slave, slaveAt(position));
+  EoeIpTask task(transport_, *slave, &emergencies_, options_.mailbox);
+  ECSIM_TRY(task.startSet(parameters, port, bus_.now()));
+  ECSIM_TRY(run(task, options_.mailboxTimeout, "EoE Set IP Parameter"));
+  return task.status();
+}
+
+Result<EoeIpParameters> Master::eoeGetIp(std::size_t position, std::uint8_t port) {
+  ECSIM_ASSIGN_OR_RETURN(SlaveInfo * slave, slaveAt(position));
+  EoeIpTask task(transport_, *slave, &emergencies_, options_.mailbox);
+  ECSIM_TRY(task.startGet(port, bus_.now()));
+  ECSIM_TRY(run(task, options_.mailboxTimeout, "EoE Get IP Parameter"));
+  ECSIM_TRY(task.status());
+  return task.parameters();
+}
+
 Result<OdList> Master::readOdList(std::size_t position) {
   ECSIM_ASSIGN_OR_RETURN(SlaveInfo * slave, slaveAt(position));
   SdoInfoTask task(transport_, *slave, &emergencies_, options_.mailbox);

@@ -30,6 +30,7 @@
 #include "master/cyclic.hpp"
 #include "master/dc.hpp"
 #include "master/eni_config.hpp"
+#include "master/eoe_client.hpp"
 #include "master/health.hpp"
 #include "master/pdo_config.hpp"
 #include "master/process_image.hpp"
@@ -161,6 +162,10 @@ class Master {
   Status sdoDownload(std::size_t position, std::uint16_t index, std::uint8_t subindex,
                      ConstBytes data, bool completeAccess = false);
   Result<OdList> readOdList(std::size_t position);
+  // EoE (ETG.1000.6 §5.7): sets the fields `parameters` includes / reads the slave's IP
+  // parameters (master/eoe_client.hpp).
+  Status eoeSetIp(std::size_t position, const EoeIpParameters& parameters, std::uint8_t port = 0);
+  Result<EoeIpParameters> eoeGetIp(std::size_t position, std::uint8_t port = 0);
   Result<ObjectDescription> readObjectDescription(std::size_t position, std::uint16_t index);
   Result<EntryDescription> readEntryDescription(std::size_t position, std::uint16_t index,
                                                 std::uint8_t subindex);

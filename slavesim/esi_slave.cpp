@@ -6,6 +6,7 @@
 #include "slavesim/coe/od_from_esi.hpp"
 #include "slavesim/coe/standard_objects.hpp"
 #include "slavesim/devices/device_models.hpp"
+#include "slavesim/eoe/eoe_server.hpp"
 #include "slavesim/generic_slave.hpp"
 
 namespace ecsim::slavesim {
@@ -137,7 +138,9 @@ Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiDevice& device, std::st
     coeOptions.coe = device.mailbox.coe;
     coeOptions.sdoInfo = device.mailbox.coeDetails.sdoInfo;
     coeOptions.completeAccess = device.mailbox.coeDetails.completeAccess;
-    slave->setMailboxServer(std::make_unique<coe::CoeServer>(od, coeOptions));
+    auto server = std::make_unique<coe::CoeServer>(od, coeOptions);
+    if (device.mailbox.eoe) server->addProtocol(std::make_unique<eoe::EoeServer>());
+    slave->setMailboxServer(std::move(server));
   }
   slave->setDevice(std::move(pd));
   for (unsigned axis = 0; !options.models.emergencies; ++axis) {
@@ -165,6 +168,12 @@ coe::ObjectDictionary* objectDictionaryOf(Slave& slave) {
 
 coe::CoeServer* coeServerOf(Slave& slave) {
   return dynamic_cast<coe::CoeServer*>(slave.mailboxServer());
+}
+
+eoe::EoeServer* eoeServerOf(Slave& slave) {
+  coe::CoeServer* server = coeServerOf(slave);
+  if (server == nullptr) return nullptr;
+  return dynamic_cast<eoe::EoeServer*>(server->protocol(MailboxType::kEoe));
 }
 
 devices::EmergencySink emergencySinkOf(Slave& slave) {

@@ -30,6 +30,7 @@
 #include "slavesim/coe/coe_server.hpp"
 #include "slavesim/coe/object_dictionary.hpp"
 #include "slavesim/devices/device_models.hpp"
+#include "slavesim/eoe/eoe_server.hpp"
 #include "slavesim/esc_type.hpp"
 #include "slavesim/process_data.hpp"
 #include "slavesim/slave.hpp"
@@ -74,6 +75,8 @@ Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiFile& file, const EsiDe
 ProcessDataDevice* processDataDeviceOf(Slave& slave);
 coe::ObjectDictionary* objectDictionaryOf(Slave& slave);
 coe::CoeServer* coeServerOf(Slave& slave);
+// The EoE server behind the slave's mailbox (ESI <Mailbox><EoE>), or nullptr.
+eoe::EoeServer* eoeServerOf(Slave& slave);
 // A sink that queues emergencies on the slave's CoE server (empty without one), for
 // devices::attachDeviceModel when a model is re-created (a simulated power cycle).
 devices::EmergencySink emergencySinkOf(Slave& slave);

@@ -14,6 +14,7 @@
 #include "protocol/sii.hpp"
 #include "slavesim/coe/od_from_esi.hpp"
 #include "slavesim/devices/device_params.hpp"
+#include "slavesim/eoe/eoe_params.hpp"
 #include "slavesim/esi_slave.hpp"
 #include "slavesim/generic_slave.hpp"
 
@@ -88,9 +89,17 @@ Result<std::unique_ptr<slavesim::Slave>> SlaveFactory::make(const TopologySlave&
     options.model = slavesim::devices::deviceModelByName(entry.model);
     if (!options.model) return at(entry, "unknown model '" + entry.model + "'");
   }
-  if (!entry.params.empty()) {
-    std::vector<slavesim::devices::DeviceParam> params;
-    for (const auto& p : entry.params) params.push_back({p.name, p.value, p.line});
+  // eoe.* go to the EoE server once the slave exists, the rest to its device model.
+  std::vector<slavesim::eoe::EoeParam> eoeParams;
+  std::vector<slavesim::devices::DeviceParam> params;
+  for (const auto& p : entry.params) {
+    if (p.name.rfind(slavesim::eoe::kEoeParamPrefix, 0) == 0) {
+      eoeParams.push_back({p.name, p.value, p.line});
+    } else {
+      params.push_back({p.name, p.value, p.line});
+    }
+  }
+  if (!params.empty()) {
     if (auto s = slavesim::devices::applyDeviceParams(options.models, params, entry.folder);
         !s.ok()) {
       return s.takeError();
@@ -118,7 +127,12 @@ Result<std::unique_ptr<slavesim::Slave>> SlaveFactory::make(const TopologySlave&
     warnings_.push_back("slave '" + entry.name + "' (" + entry.esiFile.string() +
                         "): " + std::move(n));
   }
-  if (!entry.params.empty() && slavesim::devices::deviceModelOf(**slave) == nullptr) {
+  if (!eoeParams.empty()) {
+    auto* eoe = slavesim::eoeServerOf(**slave);
+    if (eoe == nullptr) return at(entry, "eoe.* Param given, but the device's ESI lists no EoE");
+    ECSIM_TRY(slavesim::eoe::applyEoeParams(*eoe, eoeParams));
+  }
+  if (!params.empty() && slavesim::devices::deviceModelOf(**slave) == nullptr) {
     return at(entry, "Param given, but this device has no model of ecsim with parameters" +
                          std::string(entry.model == "none" ? " (model=\"none\")" : ""));
   }

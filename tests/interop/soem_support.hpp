@@ -13,6 +13,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -153,6 +154,10 @@ class SoemRun {
     auto child = ns->spawn(withRealtimePriority(std::move(timed)), SpawnOptions{outLog, outLog});
     EXPECT_TRUE(child.ok());
     if (!child.ok()) return {};
+    if (during_) {
+      during_(*ns);
+      (void)child->kill(SIGTERM);  // a program that runs until stopped (SOEM v2 eoe_test)
+    }
     auto code = child->wait(timeout + std::chrono::seconds(10));
     EXPECT_TRUE(code.ok());
     EXPECT_TRUE(server->running()) << "ecsim serve died:\n" << readText(serveLog_);
@@ -161,9 +166,12 @@ class SoemRun {
     return readText(outLog);
   }
   std::string serveLog() const { return readText(serveLog_); }
+  // Work done in the namespace while the program runs (it is stopped afterwards).
+  void setDuring(std::function<void(VethNamespace&)> during) { during_ = std::move(during); }
 
  private:
   std::vector<std::string> serveArgs_;
+  std::function<void(VethNamespace&)> during_;
   std::string serveLog_;
   int counter_{0};
 };

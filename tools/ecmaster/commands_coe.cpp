@@ -5,18 +5,7 @@
 #include "tools/ecmaster/values.hpp"
 
 namespace ecsim::tools::ecmaster {
-namespace {
 
-struct SdoOptions {
-  std::size_t position{0};
-  std::string object;  // IDX:SUB
-  std::string value;
-  std::string type;
-  bool completeAccess{false};
-  bool entries{false};
-};
-
-// Mailbox services need PREOP: a slave found in INIT is brought there (with the others).
 Status ensureMailbox(master::Master& m, std::size_t position) {
   if (position >= m.slaves().size()) {
     return makeError(ErrorCode::kNotFound, fmt::format("no slave at position {}", position));
@@ -29,6 +18,17 @@ Status ensureMailbox(master::Master& m, std::size_t position) {
   }
   return okStatus();
 }
+
+namespace {
+
+struct SdoOptions {
+  std::size_t position{0};
+  std::string object;  // IDX:SUB
+  std::string value;
+  std::string type;
+  bool completeAccess{false};
+  bool entries{false};
+};
 
 int runUpload(const GlobalOptions& g, const SdoOptions& o) {
   auto address = parseObjectAddress(o.object);
