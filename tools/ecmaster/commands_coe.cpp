@@ -16,7 +16,8 @@ struct SdoOptions {
   bool entries{false};
 };
 
-// Mailbox services need PREOP: a slave found in INIT is brought there (with the others).
+}  // namespace
+
 Status ensureMailbox(master::Master& m, std::size_t position) {
   if (position >= m.slaves().size()) {
     return makeError(ErrorCode::kNotFound, fmt::format("no slave at position {}", position));
@@ -29,6 +30,8 @@ Status ensureMailbox(master::Master& m, std::size_t position) {
   }
   return okStatus();
 }
+
+namespace {
 
 int runUpload(const GlobalOptions& g, const SdoOptions& o) {
   auto address = parseObjectAddress(o.object);
