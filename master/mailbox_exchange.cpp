@@ -32,6 +32,7 @@ Status MailboxExchange::start(ConstBytes message, SimTime now) {
                          " bytes does not fit the " + std::to_string(slave_.mailbox->outSize) +
                          "-byte mailbox of " + slave_.label());
   }
+  sendOnly_ = false;
   request_.assign(slave_.mailbox->outSize, 0);
   std::copy(message.begin(), message.end(), request_.begin());
   slave_.mailboxCounter = nextMailboxCounter(slave_.mailboxCounter);
@@ -47,10 +48,17 @@ Status MailboxExchange::start(ConstBytes message, SimTime now) {
   return okStatus();
 }
 
+Status MailboxExchange::send(ConstBytes message, SimTime now) {
+  ECSIM_TRY(start(message, now));
+  sendOnly_ = true;
+  return okStatus();
+}
+
 Status MailboxExchange::startReceive(SimTime now) {
   if (!slave_.mailbox) {
     return makeError(ErrorCode::kUnsupported, slave_.label() + " has no mailbox");
   }
+  sendOnly_ = false;
   status_ = okStatus();
   response_.clear();
   repeatsLeft_ = options_.repeatRequests;
@@ -205,6 +213,10 @@ bool MailboxExchange::step(SimTime now) {
         }
         state_ = State::kCheck;
         return wait(now, now + options_.pollInterval);
+      }
+      if (sendOnly_) {
+        state_ = State::kDone;
+        return false;
       }
       phaseStart_ = now;
       queuePoll();

@@ -54,6 +54,9 @@ class MailboxExchange final : public Task {
   // waits for the response. kInvalidArgument if the slave has no mailbox or the message
   // does not fit SM0.
   Status start(ConstBytes message, SimTime now);
+  // Sends `message` the same way and is done once the slave took it: for a request that gets
+  // no answer (the acknowledge of the last packet of an FoE read, ETG.1000.6 §5.7).
+  Status send(ConstBytes message, SimTime now);
   // Waits for one more message without sending.
   Status startReceive(SimTime now);
 
@@ -105,6 +108,7 @@ class MailboxExchange final : public Task {
   unsigned repeatsLeft_{0};
   std::uint8_t repeatBit_{0};
   std::uint64_t repeats_{0};
+  bool sendOnly_{false};
 };
 
 }  // namespace ecsim::master

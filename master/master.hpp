@@ -169,6 +169,17 @@ class Master {
   Result<ObjectDescription> readObjectDescription(std::size_t position, std::uint16_t index);
   Result<EntryDescription> readEntryDescription(std::size_t position, std::uint16_t index,
                                                 std::uint8_t subindex);
+  // BOOT (master_foe.cpp): the slave to INIT, SM0/SM1 programmed with the bootstrap mailbox
+  // of its SII (words 0x14-0x17), BOOT requested; its mailbox is the bootstrap one until
+  // leaveBootstrap() (INIT, the standard mailbox back). kUnsupported without a bootstrap
+  // mailbox in the SII; kAborted with the AL status code when the slave refuses.
+  Status enterBootstrap(std::size_t position);
+  Status leaveBootstrap(std::size_t position);
+  // FoE (master/foe_client.hpp) through the slave's mailbox as it is now (PREOP and up, or BOOT).
+  Status foeWrite(std::size_t position, const std::string& name, ConstBytes data,
+                  std::uint32_t password = 0);
+  Result<std::vector<std::uint8_t>> foeRead(std::size_t position, const std::string& name,
+                                            std::uint32_t password = 0);
   Result<std::vector<std::uint8_t>> readRegisters(std::size_t position, std::uint16_t address,
                                                   std::uint16_t length);
   Status writeRegisters(std::size_t position, std::uint16_t address, ConstBytes data);

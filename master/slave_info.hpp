@@ -56,6 +56,9 @@ struct SlaveInfo {
   // empty when none does: variables, events and messages use it before the SII's.
   std::string configuredName;
   std::optional<MailboxConfig> mailbox;
+  // While the slave is in BOOT (Master::enterBootstrap) `mailbox` is the bootstrap layout and
+  // this the standard one to go back to.
+  std::optional<MailboxConfig> standardMailbox;
   // Run-time
   std::uint8_t mailboxCounter{0};  // last counter used (1..7)
 

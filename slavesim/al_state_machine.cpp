@@ -25,9 +25,11 @@ int rank(AlState s) {
 
 }  // namespace
 
-std::uint16_t AlStateMachine::checkMailbox(const Esc& esc, const SlaveProfile::Mailbox& mbx) const {
+std::uint16_t AlStateMachine::checkMailbox(const Esc& esc, const SlaveProfile::Mailbox& mbx,
+                                          AlStatusCode failure) const {
   // SM0 must be a mailbox the master writes, SM1 one it reads, at the SII's offsets and no
-  // larger than the SII's sizes (what slave stacks check at INIT->PREOP).
+  // larger than the SII's sizes (what slave stacks check at INIT->PREOP, and at INIT->BOOT
+  // against the bootstrap layout: SOES ESC_checkmbx, AL status 0x0015 for BOOT).
   auto out = esc.smConfig(0);
   auto in = esc.smConfig(1);
   auto ok = [](const Esc::SmConfig& c, std::uint16_t start, std::uint16_t size, bool write) {
@@ -35,7 +37,7 @@ std::uint16_t AlStateMachine::checkMailbox(const Esc& esc, const SlaveProfile::M
            c.start == start && c.length >= 8 && c.length <= size;
   };
   if (!ok(out, mbx.outStart, mbx.outSize, true) || !ok(in, mbx.inStart, mbx.inSize, false)) {
-    return code(AlStatusCode::kInvalidMailboxConfigurationPreOp);
+    return code(failure);
   }
   return 0;
 }
@@ -121,7 +123,9 @@ void AlStateMachine::onAlControl(Esc& esc, const SlaveProfile& profile) {
     } else if (!profile.bootstrapMailbox) {
       errorCode = code(AlStatusCode::kBootstrapNotSupported);
     } else {
-      next = AlState::kBootstrap;
+      errorCode = checkMailbox(esc, *profile.bootstrapMailbox,
+                               AlStatusCode::kInvalidMailboxConfigurationBoot);
+      if (errorCode == 0) next = AlState::kBootstrap;
     }
   } else if (current == AlState::kBootstrap) {
     if (*requested == AlState::kInit) {
@@ -134,7 +138,10 @@ void AlStateMachine::onAlControl(Esc& esc, const SlaveProfile& profile) {
   } else if (rank(*requested) != rank(current) + 1) {
     errorCode = code(AlStatusCode::kInvalidRequestedStateChange);  // I->S, I->O, P->O
   } else if (*requested == AlState::kPreOp) {
-    if (profile.mailbox) errorCode = checkMailbox(esc, *profile.mailbox);
+    if (profile.mailbox) {
+      errorCode =
+          checkMailbox(esc, *profile.mailbox, AlStatusCode::kInvalidMailboxConfigurationPreOp);
+    }
     if (errorCode == 0) next = AlState::kPreOp;
   } else if (*requested == AlState::kSafeOp) {
     errorCode = checkProcessData(esc, profile);

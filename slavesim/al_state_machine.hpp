@@ -62,7 +62,8 @@ class AlStateMachine {
   }
 
  private:
-  std::uint16_t checkMailbox(const Esc& esc, const SlaveProfile::Mailbox& mbx) const;
+  std::uint16_t checkMailbox(const Esc& esc, const SlaveProfile::Mailbox& mbx,
+                             AlStatusCode failure) const;
   std::uint16_t checkProcessData(const Esc& esc, const SlaveProfile& profile) const;
   std::uint16_t checkSyncConfiguration(const Esc& esc, const SlaveProfile& profile) const;
 

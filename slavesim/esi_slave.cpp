@@ -7,6 +7,7 @@
 #include "slavesim/coe/standard_objects.hpp"
 #include "slavesim/devices/device_models.hpp"
 #include "slavesim/eoe/eoe_server.hpp"
+#include "slavesim/foe/foe_server.hpp"
 #include "slavesim/generic_slave.hpp"
 
 namespace ecsim::slavesim {
@@ -86,6 +87,17 @@ Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiDevice& device, std::st
     profile.mailbox = SlaveProfile::Mailbox{mbx.receiveOffset, mbx.receiveSize, mbx.sendOffset,
                                             mbx.sendSize != 0 ? mbx.sendSize : mbx.receiveSize};
   }
+  // BOOT: the bootstrap mailbox layout of the SII (ESI <Eeprom><BootStrap>).
+  const SiiMailbox& boot = sii.bootstrapMailbox;
+  if (profile.mailbox && boot.receiveSize > 0 && boot.sendSize > 0) {
+    profile.bootstrapMailbox = SlaveProfile::Mailbox{boot.receiveOffset, boot.receiveSize,
+                                                     boot.sendOffset, boot.sendSize};
+  }
+  // FoE: in the mailbox states when the ESI mailbox names it, in BOOT whenever there is one.
+  std::shared_ptr<foe::FoeFiles> foeFiles;
+  if (profile.mailbox && (device.mailbox.foe || profile.bootstrapMailbox)) {
+    foeFiles = std::make_shared<foe::FoeFiles>();
+  }
 
   // 0x1018 says what the SII says (they differ when a vendor image carries another identity).
   coe::addIdentityObject(*od, {sii.identity.vendorId, sii.identity.productCode,
@@ -124,9 +136,16 @@ Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiDevice& device, std::st
                  : devices::chooseIoProfile(*od, device.profileNo);
     }
     ECSIM_TRY(devices::attachDeviceModel(*pd, kind, modelOptions));
-    // A power cycle re-creates the model as built here (plus what outlives the power).
-    pd->setRestart([kind, modelOptions](ProcessDataDevice& d) {
+    // A power cycle re-creates the model as built here (plus what outlives the power) and
+    // boots the firmware written over FoE in BOOT, if any.
+    pd->setRestart([kind, modelOptions, foeFiles](ProcessDataDevice& d) {
+      if (foeFiles) foe::installFirmware(*foeFiles, d.dictionary());
       return devices::restartDeviceModel(d, kind, modelOptions);
+    });
+  } else if (foeFiles) {
+    pd->setRestart([foeFiles](ProcessDataDevice& d) {
+      foe::installFirmware(*foeFiles, d.dictionary());
+      return okStatus();
     });
   }
 
@@ -140,6 +159,11 @@ Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiDevice& device, std::st
     coeOptions.completeAccess = device.mailbox.coeDetails.completeAccess;
     auto server = std::make_unique<coe::CoeServer>(od, coeOptions);
     if (device.mailbox.eoe) server->addProtocol(std::make_unique<eoe::EoeServer>());
+    if (foeFiles) {
+      foe::FoeServerOptions foeOptions;
+      foeOptions.outsideBoot = device.mailbox.foe;
+      server->addProtocol(std::make_unique<foe::FoeServer>(foeFiles, foeOptions));
+    }
     slave->setMailboxServer(std::move(server));
   }
   slave->setDevice(std::move(pd));

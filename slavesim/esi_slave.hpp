@@ -14,7 +14,9 @@
 //              vendor's IO device the io or analog profile of its PDO entries, as its
 //              application, see devices/device_models.hpp and devices/io_profile.hpp.
 // Modular devices come with their modules already in `device` (config/esi_modules.hpp, done by
-// the topology builder). Bootstrap (BOOT state) is not modelled.
+// the topology builder). BOOT: the SII bootstrap mailbox (ESI <Eeprom><BootStrap>) is checked
+// at INIT->BOOT (0x0015), and an foe::FoeServer answers FoE there (and in the mailbox states
+// when the ESI mailbox has <FoE/>); a power cycle boots the image written in BOOT.
 #pragma once
 
 #include <cstdint>

@@ -142,6 +142,13 @@ void CoeServer::onRequest(Esc& esc, ConstBytes mailbox, SimTime now) {
 void CoeServer::handle(Esc& esc, ConstBytes mailbox, SimTime now) {
   auto message = decodeMailbox(mailbox);
   if (!message.ok()) return sendMailboxError(MailboxErrorCode::kInvalidSize);
+  // BOOT: the bootloader speaks FoE only (Beckhoff's EtherCAT state machine description:
+  // in Bootstrap "mailbox communication via FoE is possible, but no other mailbox
+  // communication"); CoE and the rest get "unsupported protocol" there.
+  const bool boot = AlStateMachine::state(esc) == AlState::kBootstrap;
+  if (boot && message->header.type != MailboxType::kFoe) {
+    return sendMailboxError(MailboxErrorCode::kUnsupportedProtocol);
+  }
   if (message->header.type != MailboxType::kCoe) {
     if (MailboxProtocol* p = protocol(message->header.type); p != nullptr) {
       return p->onMessage(esc, *message, *this, now);

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -186,6 +187,32 @@ TEST(EcmasterTool, UsageErrors) {
   EXPECT_NE(none.output.find("give either --iface"), std::string::npos) << none.output;
   auto noSuchIface = run({"--iface", "nosuchif0", "slaves"});
   EXPECT_EQ(noSuchIface.exitCode, 1);
+}
+
+// Issue #20: `ecmaster foe write --boot` takes the SOES demo slave (SII bootstrap mailbox) to
+// BOOT, writes the file and leaves it in INIT; a file the slave does not have is exit 1 with
+// the FoE error code and its meaning.
+TEST(EcmasterTool, FoeWriteInBootAndReadOfAMissingFile) {
+  const std::string esi = std::string(ECSIM_SHARED_DIR) + "/esi/SOES_lan9252demo_slave.xml";
+  if (!std::ifstream(esi)) {
+    const char* ci = std::getenv("CI");
+    if (ci != nullptr && std::string(ci) == "true") FAIL() << "CI=true and " << esi << " missing";
+    GTEST_SKIP() << esi << " missing";
+  }
+  const std::string topology = ::testing::TempDir() + "foe_tool_" + std::to_string(::getpid()) + ".xml";
+  std::ofstream(topology) << "<Topology name=\"foe\">\n  <Slave name=\"Soes\" esi=\"" << esi
+                          << "\" product=\"#x4D2\"/>\n</Topology>\n";
+  const std::string image = ::testing::TempDir() + "foe_tool_" + std::to_string(::getpid()) + ".bin";
+  std::ofstream(image, std::ios::binary) << std::string(300, 'x');
+  auto j = json(run({"--sim", topology, "--json", "foe", "write", "--boot", image, "-n", "fw.bin"}));
+  EXPECT_EQ(j["bytes"], 300);
+  EXPECT_EQ(j["boot"], true);
+  auto missing = run({"--sim", topology, "foe", "read", "--boot", "nothing.bin"});
+  EXPECT_EQ(missing.exitCode, 1);
+  EXPECT_NE(missing.output.find("slave answered ERR 0x8001 (not found)"), std::string::npos)
+      << missing.output;
+  std::remove(topology.c_str());
+  std::remove(image.c_str());
 }
 
 }  // namespace

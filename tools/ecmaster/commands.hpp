@@ -39,6 +39,7 @@ CommandRunner addSdosCommand(CLI::App& app, const GlobalOptions& global);
 CommandRunner addCyclicCommand(CLI::App& app, const GlobalOptions& global);
 CommandRunner addXmlCommand(CLI::App& app, const GlobalOptions& global);
 CommandRunner addEoeCommand(CLI::App& app, const GlobalOptions& global);
+CommandRunner addFoeCommand(CLI::App& app, const GlobalOptions& global);
 
 // ---- shared by the commands --------------------------------------------------------------------
 

@@ -45,6 +45,7 @@ int main(int argc, char** argv) {
       {"download", addDownloadCommand(app, global)}, {"sdos", addSdosCommand(app, global)},
       {"cyclic", addCyclicCommand(app, global)},     {"xml", addXmlCommand(app, global)},
       {"eoe", addEoeCommand(app, global)},
+      {"foe", addFoeCommand(app, global)},
   };
   CLI11_PARSE(app, argc, argv);
   try {
