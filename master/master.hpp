@@ -35,6 +35,7 @@
 #include "master/process_image.hpp"
 #include "master/scan.hpp"
 #include "master/slave_info.hpp"
+#include "master/soe_client.hpp"
 #include "master/state_change.hpp"
 #include "master/transport.hpp"
 #include "master/variables.hpp"
@@ -160,6 +161,11 @@ class Master {
                                               std::uint8_t subindex, bool completeAccess = false);
   Status sdoDownload(std::size_t position, std::uint16_t index, std::uint8_t subindex,
                      ConstBytes data, bool completeAccess = false);
+  // SoE (master/soe_client.hpp): the elements of one IDN of drive `driveNo`, in element order;
+  // a write sets the value element.
+  Result<std::vector<std::uint8_t>> soeRead(std::size_t position, std::uint8_t driveNo,
+                                            std::uint8_t elements, std::uint16_t idn);
+  Status soeWrite(std::size_t position, std::uint8_t driveNo, std::uint16_t idn, ConstBytes value);
   Result<OdList> readOdList(std::size_t position);
   Result<ObjectDescription> readObjectDescription(std::size_t position, std::uint16_t index);
   Result<EntryDescription> readEntryDescription(std::size_t position, std::uint16_t index,

@@ -7,6 +7,7 @@
 #include "slavesim/coe/standard_objects.hpp"
 #include "slavesim/devices/device_models.hpp"
 #include "slavesim/generic_slave.hpp"
+#include "slavesim/soe/soe_server.hpp"
 
 namespace ecsim::slavesim {
 namespace {
@@ -137,7 +138,23 @@ Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiDevice& device, std::st
     coeOptions.coe = device.mailbox.coe;
     coeOptions.sdoInfo = device.mailbox.coeDetails.sdoInfo;
     coeOptions.completeAccess = device.mailbox.coeDetails.completeAccess;
-    slave->setMailboxServer(std::make_unique<coe::CoeServer>(od, coeOptions));
+    auto server = std::make_unique<coe::CoeServer>(od, coeOptions);
+    if (device.mailbox.soe) {
+      const EsiDictionary none;
+      if (options.soeDictionary == nullptr && options.warnings != nullptr) {
+        options.warnings->push_back(
+            "the ESI mailbox has SoE but no SoE dictionary is given: the drive serves only the "
+            "IDN lists every drive has");
+      }
+      std::vector<soe::IdnDictionary> drives;
+      for (unsigned n = 0; n < std::max<unsigned>(1, device.mailbox.soeChannels); ++n) {
+        drives.push_back(soe::buildIdnDictionary(
+            options.soeDictionary != nullptr ? *options.soeDictionary : none,
+            options.soeDictionaryFile, n == 0 ? options.warnings : nullptr));
+      }
+      server->addProtocol(std::make_unique<soe::SoeServer>(std::move(drives)));
+    }
+    slave->setMailboxServer(std::move(server));
   }
   slave->setDevice(std::move(pd));
   for (unsigned axis = 0; !options.models.emergencies; ++axis) {

@@ -36,6 +36,7 @@ CommandRunner addPdosCommand(CLI::App& app, const GlobalOptions& global);
 CommandRunner addUploadCommand(CLI::App& app, const GlobalOptions& global);
 CommandRunner addDownloadCommand(CLI::App& app, const GlobalOptions& global);
 CommandRunner addSdosCommand(CLI::App& app, const GlobalOptions& global);
+CommandRunner addSoeCommand(CLI::App& app, const GlobalOptions& global);
 CommandRunner addCyclicCommand(CLI::App& app, const GlobalOptions& global);
 CommandRunner addXmlCommand(CLI::App& app, const GlobalOptions& global);
 
@@ -46,6 +47,8 @@ CommandRunner addXmlCommand(CLI::App& app, const GlobalOptions& global);
 // `recovery`: MasterOptions::recovery (cyclic health: lost slaves reported and brought back).
 Result<std::unique_ptr<Connection>> connectAndScan(const GlobalOptions& global, bool reset,
                                                    bool recovery = true);
+// Mailbox services need PREOP: a slave found in INIT is brought there (with the others).
+Status ensureMailbox(master::Master& m, std::size_t position);
 // Prints "ecmaster: <message>" to stderr and returns 1.
 int fail(const Error& error);
 int fail(const std::string& message);

@@ -16,20 +16,6 @@ struct SdoOptions {
   bool entries{false};
 };
 
-// Mailbox services need PREOP: a slave found in INIT is brought there (with the others).
-Status ensureMailbox(master::Master& m, std::size_t position) {
-  if (position >= m.slaves().size()) {
-    return makeError(ErrorCode::kNotFound, fmt::format("no slave at position {}", position));
-  }
-  if (!m.slaves()[position].mailbox) {
-    return makeError(ErrorCode::kUnsupported, m.slaves()[position].label() + " has no mailbox");
-  }
-  if (m.slaves()[position].state().value_or(AlState::kInit) == AlState::kInit) {
-    return m.bringTo(AlState::kPreOp);
-  }
-  return okStatus();
-}
-
 int runUpload(const GlobalOptions& g, const SdoOptions& o) {
   auto address = parseObjectAddress(o.object);
   if (!address.ok()) return fail(address.error());
@@ -148,6 +134,19 @@ int runSdos(const GlobalOptions& g, const SdoOptions& o) {
 }
 
 }  // namespace
+
+Status ensureMailbox(master::Master& m, std::size_t position) {
+  if (position >= m.slaves().size()) {
+    return makeError(ErrorCode::kNotFound, fmt::format("no slave at position {}", position));
+  }
+  if (!m.slaves()[position].mailbox) {
+    return makeError(ErrorCode::kUnsupported, m.slaves()[position].label() + " has no mailbox");
+  }
+  if (m.slaves()[position].state().value_or(AlState::kInit) == AlState::kInit) {
+    return m.bringTo(AlState::kPreOp);
+  }
+  return okStatus();
+}
 
 CommandRunner addUploadCommand(CLI::App& app, const GlobalOptions& global) {
   auto o = std::make_shared<SdoOptions>();

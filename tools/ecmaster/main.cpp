@@ -44,6 +44,7 @@ int main(int argc, char** argv) {
       {"pdos", addPdosCommand(app, global)},         {"upload", addUploadCommand(app, global)},
       {"download", addDownloadCommand(app, global)}, {"sdos", addSdosCommand(app, global)},
       {"cyclic", addCyclicCommand(app, global)},     {"xml", addXmlCommand(app, global)},
+      {"soe", addSoeCommand(app, global)},
   };
   CLI11_PARSE(app, argc, argv);
   try {
