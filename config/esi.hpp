@@ -152,6 +152,8 @@ struct EsiFlags {
   std::string writeRestrictions;  // e.g. "PreOP"
   std::string category;           // m, o, c
   std::string pdoMapping;         // R, T, RT (as written, case kept)
+  // <Attribute> of an SoE IDN (EtherCATDict files: protocol/soe.hpp SoeAttribute bits).
+  std::optional<std::uint32_t> soeAttribute;
   bool rxMappable() const;
   bool txMappable() const;
 };
@@ -205,6 +207,8 @@ struct EsiObject {
   std::vector<EsiSubItemInfo> subItems;
   EsiFlags flags;
   bool dependOnSlot{false};  // <Index DependOnSlot="1">: a module's object, moved per slot
+  // <Properties><Property><Name>UnitName</Name><Desc>us</Desc> (SoE dictionaries): the unit.
+  std::string unitName;
   int line{0};
   std::string name() const { return std::string(pickLocalText(names)); }
 };

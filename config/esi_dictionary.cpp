@@ -35,6 +35,7 @@ Result<EsiFlags> readFlags(const xml::Context& ctx, const Element* flags) {
   }
   out.category = std::string(xml::childText(flags, "Category"));
   out.pdoMapping = std::string(xml::childText(flags, "PdoMapping"));
+  ECSIM_ASSIGN_OR_RETURN(out.soeAttribute, xml::childNumber<std::uint32_t>(ctx, flags, "Attribute"));
   return out;
 }
 
@@ -132,6 +133,12 @@ Result<EsiObject> readObject(const xml::Context& ctx, const Element* e) {
     out.subItems.push_back(std::move(sub));
   }
   ECSIM_ASSIGN_OR_RETURN(out.flags, readFlags(ctx, e->FirstChildElement("Flags")));
+  for (const Element* p : Children(e->FirstChildElement("Properties"), "Property")) {
+    if (xml::childText(p, "Name") != "UnitName") continue;
+    const auto desc = xml::localTexts(p, "Desc");
+    out.unitName = desc.empty() ? std::string(xml::childText(p, "Value"))
+                                : std::string(pickLocalText(desc));
+  }
   return out;
 }
 

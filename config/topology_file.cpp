@@ -83,7 +83,7 @@ const xml::Names kEniSlaveNames{{"name", "model", "stateFile"}, {"Input", "Param
 const xml::Names kMasterNames{{"cable", "redundant", "redundantCable"}};
 const xml::Names kSlaveNames{
     {"name", "esi", "product", "revision", "device", "eeprom", "esc", "dc", "processingDelayNs",
-     "forwardingDelayNs", "stateFile", "modules", "model"},
+     "forwardingDelayNs", "stateFile", "modules", "model", "soeDictionary"},
     {"Clock", "Input", "Param", "Module"},
     {"Clock"}};
 // <Slave model="...">: the device models a topology may choose (docs/devices.md).
@@ -191,6 +191,12 @@ Result<TopologySlave> parseSlave(const xml::Context& ctx, const Element* e,
   s.folder = folder;
   ECSIM_TRY(parseInputsAndParams(ctx, e, s));
   if (const char* moduleFile = e->Attribute("modules")) s.moduleFile = folder / moduleFile;
+  if (const char* dict = e->Attribute("soeDictionary")) {
+    if (s.esiFile.empty()) {
+      return ctx.error(e, "Slave '" + s.name + "': soeDictionary= needs a device from an ESI file (esi=)");
+    }
+    s.soeDictionaryFile = folder / dict;
+  }
   for (const Element* m : xml::Children(e, "Module")) {
     TopologyModule module;
     module.line = m->GetLineNum();

@@ -71,6 +71,9 @@ struct TopologySlave {
   // the ESI file holding them (empty: the device's file, then every ESI file in its folder).
   std::vector<TopologyModule> modules;
   std::filesystem::path moduleFile;
+  // SoE devices: the EtherCATDict file holding the drive's IDNs (soeDictionary=, resolved
+  // against the topology file's folder).
+  std::filesystem::path soeDictionaryFile;
   int line{0};
 };
 

@@ -397,6 +397,25 @@ Result<EoeIpParameters> Master::eoeGetIp(std::size_t position, std::uint8_t port
   return task.parameters();
 }
 
+Result<std::vector<std::uint8_t>> Master::soeRead(std::size_t position, std::uint8_t driveNo,
+                                                  std::uint8_t elements, std::uint16_t idn) {
+  ECSIM_ASSIGN_OR_RETURN(SlaveInfo * slave, slaveAt(position));
+  SoeTask task(transport_, *slave, &emergencies_, options_.mailbox);
+  ECSIM_TRY(task.startRead(driveNo, elements, idn, bus_.now()));
+  ECSIM_TRY(run(task, options_.mailboxTimeout, "SoE read"));
+  ECSIM_TRY(task.status());
+  return task.data();
+}
+
+Status Master::soeWrite(std::size_t position, std::uint8_t driveNo, std::uint16_t idn,
+                        ConstBytes value) {
+  ECSIM_ASSIGN_OR_RETURN(SlaveInfo * slave, slaveAt(position));
+  SoeTask task(transport_, *slave, &emergencies_, options_.mailbox);
+  ECSIM_TRY(task.startWrite(driveNo, idn, value, bus_.now()));
+  ECSIM_TRY(run(task, options_.mailboxTimeout, "SoE write"));
+  return task.status();
+}
+
 Result<OdList> Master::readOdList(std::size_t position) {
   ECSIM_ASSIGN_OR_RETURN(SlaveInfo * slave, slaveAt(position));
   SdoInfoTask task(transport_, *slave, &emergencies_, options_.mailbox);

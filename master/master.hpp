@@ -36,6 +36,7 @@
 #include "master/process_image.hpp"
 #include "master/scan.hpp"
 #include "master/slave_info.hpp"
+#include "master/soe_client.hpp"
 #include "master/state_change.hpp"
 #include "master/transport.hpp"
 #include "master/variables.hpp"
@@ -161,6 +162,11 @@ class Master {
                                               std::uint8_t subindex, bool completeAccess = false);
   Status sdoDownload(std::size_t position, std::uint16_t index, std::uint8_t subindex,
                      ConstBytes data, bool completeAccess = false);
+  // SoE (master/soe_client.hpp): the elements of one IDN of drive `driveNo`, in element order;
+  // a write sets the value element.
+  Result<std::vector<std::uint8_t>> soeRead(std::size_t position, std::uint8_t driveNo,
+                                            std::uint8_t elements, std::uint16_t idn);
+  Status soeWrite(std::size_t position, std::uint8_t driveNo, std::uint16_t idn, ConstBytes value);
   Result<OdList> readOdList(std::size_t position);
   // EoE (ETG.1000.6 §5.7): sets the fields `parameters` includes / reads the slave's IP
   // parameters (master/eoe_client.hpp).

@@ -9,6 +9,7 @@
 #include "slavesim/eoe/eoe_server.hpp"
 #include "slavesim/foe/foe_server.hpp"
 #include "slavesim/generic_slave.hpp"
+#include "slavesim/soe/soe_server.hpp"
 
 namespace ecsim::slavesim {
 namespace {
@@ -163,6 +164,21 @@ Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiDevice& device, std::st
       foe::FoeServerOptions foeOptions;
       foeOptions.outsideBoot = device.mailbox.foe;
       server->addProtocol(std::make_unique<foe::FoeServer>(foeFiles, foeOptions));
+    }
+    if (device.mailbox.soe) {
+      const EsiDictionary none;
+      if (options.soeDictionary == nullptr && options.warnings != nullptr) {
+        options.warnings->push_back(
+            "the ESI mailbox has SoE but no SoE dictionary is given: the drive serves only the "
+            "IDN lists every drive has");
+      }
+      std::vector<soe::IdnDictionary> drives;
+      for (unsigned n = 0; n < std::max<unsigned>(1, device.mailbox.soeChannels); ++n) {
+        drives.push_back(soe::buildIdnDictionary(
+            options.soeDictionary != nullptr ? *options.soeDictionary : none,
+            options.soeDictionaryFile, n == 0 ? options.warnings : nullptr));
+      }
+      server->addProtocol(std::make_unique<soe::SoeServer>(std::move(drives)));
     }
     slave->setMailboxServer(std::move(server));
   }

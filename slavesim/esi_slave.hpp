@@ -6,7 +6,9 @@
 //   dictionary coe/od_from_esi.hpp, identity taken from the SII so SII and 0x1018 agree;
 //   mailbox    a CoeServer for any device with a standard mailbox (SdoInfo / CompleteAccess
 //              from the ESI <CoE> element); other protocols (and CoE, when the ESI mailbox
-//              has none) get "unsupported protocol" mailbox error replies;
+//              has none) get "unsupported protocol" mailbox error replies; a device whose
+//              ESI mailbox has <SoE> gets an SoE server (soe/soe_server.hpp) with one drive
+//              per <SoE ChannelCount>, its IDNs from options.soeDictionary;
 //   device     ProcessDataDevice over the same dictionary (also for SII-only slaves, whose
 //              dictionary no mailbox reaches); ESI Virtual SMs are neither checked nor copied;
 //              ecsim's own devices get their model (IO terminal, CiA 402 drive), and any
@@ -56,6 +58,11 @@ struct EsiSlaveOptions {
   // Parameters of the device model (devices/device_params.hpp). A drive's emergencies go to
   // the slave's CoE server unless models.emergencies is set.
   devices::DeviceModelOptions models;
+  // SoE devices (ESI <Mailbox><SoE>): each drive's IDNs from this EtherCATDict dictionary
+  // (soe/idn_dictionary.hpp; a topology's <Slave soeDictionary=>); nullptr: the IDN lists
+  // every drive has, nothing else (said in `warnings`). `soeDictionaryFile` names it.
+  const EsiDictionary* soeDictionary{nullptr};
+  std::string soeDictionaryFile;
   // Where the build says what it could not take as written (dictionary notes of
   // coe::buildObjectDictionary, a default PDO configuration that cannot be bound); nullptr: not
   // reported.

@@ -114,6 +114,18 @@ Result<std::unique_ptr<slavesim::Slave>> SlaveFactory::make(const TopologySlave&
   if (entry.model == "loopback" && options.models.loopbackFrom.empty()) {
     return at(entry, "model=\"loopback\" needs <Param name=\"loopback.from\" value=\"SLAVE\"/>");
   }
+  if (!entry.soeDictionaryFile.empty()) {
+    if (!device->mailbox.soe) {
+      return at(entry, "soeDictionary given, but the ESI mailbox of this device has no <SoE>");
+    }
+    ECSIM_ASSIGN_OR_RETURN(const EsiFile* dict, esiFile(entry.soeDictionaryFile));
+    if (dict->root != EsiRoot::kEtherCatDict) {
+      return at(entry, "soeDictionary " + entry.soeDictionaryFile.string() +
+                           " is no EtherCATDict file (its IDNs are the <Object>s of one)");
+    }
+    options.soeDictionary = &dict->dictionary;
+    options.soeDictionaryFile = entry.soeDictionaryFile.string();
+  }
   ECSIM_ASSIGN_OR_RETURN(const EsiDevice configured, withModules(entry, file, *device));
   std::vector<std::string> notes;
   options.warnings = &notes;

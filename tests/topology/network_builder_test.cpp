@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include "slavesim/esi_slave.hpp"
+#include "slavesim/soe/soe_server.hpp"
 #include "support/fifo.hpp"
 #include "support/test_network.hpp"
 
@@ -91,6 +93,63 @@ TEST(NetworkBuilder, EepromImageThatIsNotARegularFileIsRefused) {
   EXPECT_NE(built.error().context.find(fifo.string() + ": is a FIFO, not a regular file"),
             std::string::npos)
       << built.error().context;
+}
+
+}  // namespace
+}  // namespace ecsim::testing
+
+namespace ecsim::testing {
+namespace {
+
+// SoE drives (docs/devices.md#soe-drives): the topology names the EtherCATDict file with a
+// drive's IDNs; the slave's mailbox gets an SoE server with them.
+TEST(NetworkBuilder, SoeDriveServesTheDictionaryItsTopologyNames) {
+  auto cfg = loadTopologyFile(std::filesystem::path(ECSIM_SOURCE_DIR) /
+                              "examples/topologies/soe_drive.xml");
+  ASSERT_TRUE(cfg.ok()) << cfg.error().message();
+  auto net = topology::buildNetwork(*cfg);
+  ASSERT_TRUE(net.ok()) << net.error().message();
+  EXPECT_TRUE(net->warnings.empty()) << net->warnings.front();
+  auto* coe = slavesim::coeServerOf(net->segment->slave(1));
+  ASSERT_NE(coe, nullptr);
+  auto* soe = dynamic_cast<slavesim::soe::SoeServer*>(coe->protocol(MailboxType::kSoe));
+  ASSERT_NE(soe, nullptr);
+  ASSERT_EQ(soe->driveCount(), 1u) << "<SoE ChannelCount=\"1\">";
+  EXPECT_EQ(soe->drive(0).size(), 20u);
+  ASSERT_NE(soe->drive(0).find(47), nullptr);
+  EXPECT_EQ(soe->drive(0).find(47)->name, "Position command value");
+  EXPECT_EQ(coe->protocol(MailboxType::kSoe), soe);
+  EXPECT_EQ(slavesim::coeServerOf(net->segment->slave(0)), nullptr) << "the coupler has none";
+}
+
+TEST(NetworkBuilder, SoeDictionaryNeedsAnSoeDeviceAndAnEtherCatDictFile) {
+  const auto file = std::filesystem::path(ECSIM_SOURCE_DIR) / "examples/topologies/t.xml";
+  auto build = [&](const std::string& slave) {
+    auto cfg = parseTopology("<Topology>\n" + slave + "\n</Topology>", file);
+    if (!cfg.ok()) return Result<topology::Network>(cfg.takeError());
+    return topology::buildNetwork(*cfg);
+  };
+  auto coupler = build(
+      "<Slave name=\"C\" esi=\"../esi/ecsim_devices.xml\" product=\"#x00001100\" "
+      "soeDictionary=\"../esi/soe/ecs5101_dict.xml\"/>");
+  ASSERT_FALSE(coupler.ok());
+  EXPECT_NE(coupler.error().context.find("has no <SoE>"), std::string::npos)
+      << coupler.error().context;
+  auto notDict = build(
+      "<Slave name=\"A\" esi=\"../esi/ecsim_soe_drive.xml\" product=\"#x00005101\" "
+      "soeDictionary=\"../esi/ecsim_devices.xml\"/>");
+  ASSERT_FALSE(notDict.ok());
+  EXPECT_NE(notDict.error().context.find("is no EtherCATDict file"), std::string::npos)
+      << notDict.error().context;
+  auto noEsi = build("<Slave name=\"G\" soeDictionary=\"../esi/soe/ecs5101_dict.xml\"/>");
+  ASSERT_FALSE(noEsi.ok());
+  EXPECT_NE(noEsi.error().context.find("line 2"), std::string::npos) << noEsi.error().context;
+  // Without a dictionary the drive has the lists every drive derives, and a warning says so.
+  auto bare =
+      build("<Slave name=\"A\" esi=\"../esi/ecsim_soe_drive.xml\" product=\"#x00005101\"/>");
+  ASSERT_TRUE(bare.ok()) << bare.error().message();
+  ASSERT_EQ(bare->warnings.size(), 1u);
+  EXPECT_NE(bare->warnings[0].find("no SoE dictionary"), std::string::npos) << bare->warnings[0];
 }
 
 }  // namespace

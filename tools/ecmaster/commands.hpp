@@ -36,6 +36,7 @@ CommandRunner addPdosCommand(CLI::App& app, const GlobalOptions& global);
 CommandRunner addUploadCommand(CLI::App& app, const GlobalOptions& global);
 CommandRunner addDownloadCommand(CLI::App& app, const GlobalOptions& global);
 CommandRunner addSdosCommand(CLI::App& app, const GlobalOptions& global);
+CommandRunner addSoeCommand(CLI::App& app, const GlobalOptions& global);
 CommandRunner addCyclicCommand(CLI::App& app, const GlobalOptions& global);
 CommandRunner addXmlCommand(CLI::App& app, const GlobalOptions& global);
 CommandRunner addEoeCommand(CLI::App& app, const GlobalOptions& global);

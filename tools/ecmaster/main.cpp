@@ -46,6 +46,7 @@ int main(int argc, char** argv) {
       {"cyclic", addCyclicCommand(app, global)},     {"xml", addXmlCommand(app, global)},
       {"eoe", addEoeCommand(app, global)},
       {"foe", addFoeCommand(app, global)},
+      {"soe", addSoeCommand(app, global)},
   };
   CLI11_PARSE(app, argc, argv);
   try {
