@@ -124,6 +124,8 @@ bool DcInitTask::fail(Error error) {
 void DcInitTask::start(SimTime now) {
   status_ = okStatus();
   setup_ = {};
+  driftSent_ = 0;
+  driftLostInRow_ = 0;
   setup_.dc.assign(slaves_.size(), false);
   setup_.assignActivate.assign(slaves_.size(), 0);
   for (const auto& s : slaves_) {
@@ -193,7 +195,18 @@ bool DcInitTask::step(SimTime now) {
   if (phase_ == Phase::kDone) return false;
   if (batch_.pending()) return true;
   // BWR/FRMW counts vary with the network; only their arrival matters.
-  if (phase_ == Phase::kLatch || phase_ == Phase::kDrift) {
+  if (phase_ == Phase::kDrift && !batch_[0].received()) {
+    ++setup_.driftFramesLost;
+    if (++driftLostInRow_ >= options_.maxDriftFramesLostInRow) {
+      return fail(makeError(ErrorCode::kTimeout,
+                            batch_[0].describe() + ": " + std::to_string(driftLostInRow_) +
+                                " static drift frames lost in a row (" +
+                                std::to_string(setup_.driftFramesLost) + " of " +
+                                std::to_string(driftSent_) + " sent)"));
+    }
+  } else if (phase_ == Phase::kDrift) {
+    driftLostInRow_ = 0;
+  } else if (phase_ == Phase::kLatch) {
     if (!batch_[0].received()) return fail(makeError(ErrorCode::kTimeout, batch_[0].describe()));
   } else if (phase_ == Phase::kWrite) {
     for (std::size_t i = 0; i + 1 < batch_.size(); ++i) {

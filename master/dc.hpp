@@ -9,7 +9,9 @@
 //      reference clock (the first DC slave); FPWR 0x0928 delay and 0x0920 offset (master time
 //      at the latch minus the slave's 0x0918), BWR 0x0930 resets the drift filters;
 //   4. static drift compensation: `staticDriftFrames` FRMW of the reference's 0x0910, one per
-//      frame;
+//      frame. Each only nudges the slaves' drift filters, so a lost one is counted
+//      (DcSetup::driftFramesLost) and the next sent, as a frame lost in the cyclic FRMW is; only
+//      `maxDriftFramesLostInRow` lost one after the other (the reference clock gone) fail;
 //   5. SYNC0: for the slaves that ask for it, FPRD the reference's system time, then FPWR
 //      0x0981 = 0, 0x09A0 cycle time, 0x0990 start time (a whole number of cycles at least
 //      `sync0StartDelay` ahead, plus the shift) and 0x0980/0x0981 = AssignActivate (0x0300:
@@ -35,6 +37,9 @@ namespace ecsim::master {
 struct DcOptions {
   bool enable{false};  // Master::start() runs the DC set-up
   std::size_t staticDriftFrames{15000};
+  // Static drift frames lost one after the other (each after every retry) before the set-up
+  // fails: one lost frame of 15,000 is a busy host or a noisy cable, not a missing reference.
+  std::size_t maxDriftFramesLostInRow{3};
   bool activateSync0{true};
   SimTime sync0Cycle{0};  // 0: MasterOptions::cycleTime
   SimTime sync0Shift{0};
@@ -70,6 +75,7 @@ struct DcSetup {
   std::vector<std::uint16_t> assignActivate;  // per slave: the 0x0980 word written (0: none)
   std::uint64_t sync0Start{0};                // 0x0990 written
   SimTime sync0Cycle{0};
+  std::size_t driftFramesLost{0};  // static drift FRMWs given up after every retry
 };
 
 class DcInitTask final : public Task {
@@ -98,6 +104,7 @@ class DcInitTask final : public Task {
   Phase phase_{Phase::kDone};
   DatagramBatch batch_;
   std::size_t driftSent_{0};
+  std::size_t driftLostInRow_{0};
   std::uint64_t masterTime_{0};
   Status status_;
 };
