@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <linux/capability.h>
+#include <sched.h>
 #include <spawn.h>
 #include <sys/random.h>
 #include <sys/syscall.h>
@@ -73,6 +74,15 @@ class SpawnSetup {
                                      0644);
   }
   void duplicate(int from, int to) { posix_spawn_file_actions_adddup2(&actions_, from, to); }
+  void fifo(int priority) {
+    short flags = 0;
+    posix_spawnattr_getflags(&attributes_, &flags);
+    posix_spawnattr_setflags(&attributes_, static_cast<short>(flags | POSIX_SPAWN_SETSCHEDULER));
+    posix_spawnattr_setschedpolicy(&attributes_, SCHED_FIFO);
+    sched_param param{};
+    param.sched_priority = priority;
+    posix_spawnattr_setschedparam(&attributes_, &param);
+  }
 
   Result<pid_t> spawn(const std::vector<std::string>& argv) {
     if (argv.empty()) return makeError(ErrorCode::kInvalidArgument, "empty command line");
@@ -234,6 +244,7 @@ Result<ChildProcess> spawnProcess(const std::vector<std::string>& argv,
       setup.openFile(2, options.stderrPath);
     }
   }
+  if (options.fifoPriority > 0) setup.fifo(options.fifoPriority);
   ECSIM_ASSIGN_OR_RETURN(pid_t pid, setup.spawn(argv));
   return ChildProcess(pid);
 }

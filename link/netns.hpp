@@ -30,6 +30,9 @@ Status checkNetworkCapabilities();
 struct SpawnOptions {
   std::string stdoutPath;
   std::string stderrPath;  // may equal stdoutPath: both streams then share the file
+  // SCHED_FIFO priority of the child (and of what it starts); 0: the caller's policy. Needs
+  // root or CAP_SYS_NICE (RealTimeThread::permitted()); without it the spawn fails.
+  int fifoPriority{0};
 };
 
 // A child process in its own process group. kill() signals the whole group; the destructor

@@ -1,6 +1,7 @@
 #include "link/netns.hpp"
 
 #include <gtest/gtest.h>
+#include <sched.h>
 
 #include <chrono>
 #include <csignal>
@@ -10,6 +11,7 @@
 #include <string>
 
 #include "link/net_namespace.hpp"
+#include "link/realtime.hpp"
 #include "test_support.hpp"
 
 namespace ecsim {
@@ -129,6 +131,41 @@ TEST(VethNamespace, SpawnsProgramsInsideTheNamespace) {
   ASSERT_TRUE(stopped.ok()) << stopped.error().message();
   EXPECT_EQ(*stopped, 128 + SIGTERM);
   EXPECT_FALSE(sleeper->running());
+}
+
+// The scenario engine starts an external master at SCHED_FIFO below its own thread (scenario/
+// external_master.cpp): the priority reaches the program and what it starts, and the thread's
+// own policy comes back when the guard ends.
+TEST(RealTime, SpawnPriorityReachesTheProgramAndTheThreadGetsItsPolicyBack) {
+  const int before = sched_getscheduler(0);
+  {
+    RealTimeThread rt(30);
+    if (!rt.ok()) {
+      if (::ecsim::testing::inCi()) FAIL() << "CI=true and SCHED_FIFO " << rt.note();
+      GTEST_SKIP() << "SCHED_FIFO " << rt.note();
+    }
+    EXPECT_EQ(sched_getscheduler(0), SCHED_FIFO);
+    EXPECT_EQ(rt.note(), "SCHED_FIFO 30");
+    const std::string out =
+        std::filesystem::temp_directory_path() / ("ecsim-link-fifo-" + std::to_string(::getpid()));
+    auto child =
+        spawnProcess({"sh", "-c", "chrt -p $$; sh -c 'chrt -p $$'"}, SpawnOptions{out, out, 12});
+    ASSERT_TRUE(child.ok()) << child.error().message();
+    auto code = child->wait(30s);
+    ASSERT_TRUE(code.ok()) << code.error().message();
+    EXPECT_EQ(*code, 0);
+    const std::string text = readText(out);
+    std::filesystem::remove(out);
+    std::size_t fifo = 0;
+    std::size_t twelve = 0;
+    for (std::size_t at = 0; (at = text.find("SCHED_FIFO", at)) != std::string::npos; ++at) ++fifo;
+    for (std::size_t at = 0; (at = text.find("priority: 12", at)) != std::string::npos; ++at) {
+      ++twelve;
+    }
+    EXPECT_EQ(fifo, 2u) << text;  // the shell and the shell it started
+    EXPECT_EQ(twelve, 2u) << text;
+  }
+  EXPECT_EQ(sched_getscheduler(0), before);
 }
 
 TEST(VethNamespace, ReportsAMissingProgram) {

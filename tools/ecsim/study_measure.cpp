@@ -6,8 +6,6 @@
 // jitter (master/histogram.hpp), lost and late frames, overruns (a cycle that ended after the
 // next should have begun). The namespace, the pair and the server are removed on every path.
 #include <fmt/core.h>
-#include <pthread.h>
-#include <sched.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -19,6 +17,7 @@
 
 #include "link/netns.hpp"
 #include "link/raw_socket_link.hpp"
+#include "link/realtime.hpp"
 #include "link/signal_flag.hpp"
 #include "master/master.hpp"
 #include "tools/ecsim/study_network.hpp"
@@ -57,32 +56,6 @@ Status waitForServer(const std::filesystem::path& log, ChildProcess& server,
   }
   return makeError(ErrorCode::kTimeout, "ecsim serve did not start: " + readWhole(log));
 }
-
-// SCHED_FIFO for the thread running the master, restored on destruction; a note when refused.
-class RealTimeThread {
- public:
-  RealTimeThread() {
-    (void)pthread_getschedparam(pthread_self(), &policy_, &saved_);
-    sched_param p{};
-    p.sched_priority = kMasterPriority;
-    const int e = pthread_setschedparam(pthread_self(), SCHED_FIFO, &p);
-    ok_ = e == 0;
-    note_ = ok_ ? fmt::format("master thread SCHED_FIFO {}", kMasterPriority)
-                : fmt::format("master thread not real-time ({})", std::strerror(e));
-  }
-  ~RealTimeThread() {
-    if (ok_) (void)pthread_setschedparam(pthread_self(), policy_, &saved_);
-  }
-  RealTimeThread(const RealTimeThread&) = delete;
-  RealTimeThread& operator=(const RealTimeThread&) = delete;
-  const std::string& note() const { return note_; }
-
- private:
-  int policy_{SCHED_OTHER};
-  sched_param saved_{};
-  bool ok_{false};
-  std::string note_;
-};
 
 Result<MeasuredCycle> runCandidate(master::Master& m, master::Bus& bus, double cycleUs,
                                    double seconds, const SignalFlag& stop, Progress& progress) {
@@ -154,9 +127,10 @@ Result<std::vector<MeasuredCycle>> measureOurs(const NetworkStudyOptions& o,
   master::Master m(link, bus, options);
   if (auto names = topology::loadSlaveNames(o.topology); names.ok()) m.setSlaveNames(*names);
   if (isEniFile(o.topology)) ECSIM_TRY(m.loadConfig(o.topology));
-  RealTimeThread rt;
-  progress.update(fmt::format("measuring: bringing the served network to OP ({})", rt.note()),
-                  true);
+  RealTimeThread rt(kMasterPriority);
+  progress.update(
+      fmt::format("measuring: bringing the served network to OP (master thread {})", rt.note()),
+      true);
   const SimTime cycleTimeout = m.transport().options().timeout;
   m.transport().setTimeout(kBringUpFrameTimeout);
   if (auto s = m.start(); !s.ok()) {
