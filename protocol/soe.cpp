@@ -197,6 +197,17 @@ SoeAttribute SoeAttribute::make(std::size_t elementSize, bool list, bool command
   return SoeAttribute{raw};
 }
 
+std::int64_t soeNumber(ConstBytes element, bool isSigned) {
+  std::uint64_t raw = 0;
+  for (std::size_t i = 0; i < element.size() && i < 8; ++i) {
+    raw |= static_cast<std::uint64_t>(element[i]) << (8 * i);
+  }
+  if (isSigned && element.size() < 8 && !element.empty() && (element.back() & 0x80) != 0) {
+    raw |= ~std::uint64_t{0} << (8 * element.size());
+  }
+  return static_cast<std::int64_t>(raw);
+}
+
 std::string_view soeErrorText(std::uint16_t code) {
   switch (code) {
     case 0x0000:

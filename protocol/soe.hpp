@@ -140,6 +140,10 @@ struct SoeAttribute {
                            bool wpPreop, bool wpSafeop, bool wpOp);
 };
 
+// One element's value, little-endian, of 1 to 8 bytes, sign-extended when `isSigned` (the
+// data types kSigned; every other type reads unsigned).
+std::int64_t soeNumber(ConstBytes element, bool isSigned);
+
 // Error codes (IEC 61800-7-204; SOEM ethercatprint.c and IgH soe_errors.c list the same).
 namespace soe_error {
 constexpr std::uint16_t kNoIdn = 0x1001;

@@ -20,26 +20,15 @@ unsigned phaseOf(const Esc& esc) {
   }
 }
 
-std::int64_t asNumber(ConstBytes bytes, bool isSigned) {
-  std::uint64_t raw = 0;
-  for (std::size_t i = 0; i < bytes.size() && i < 8; ++i) {
-    raw |= static_cast<std::uint64_t>(bytes[i]) << (8 * i);
-  }
-  if (isSigned && bytes.size() < 8 && !bytes.empty() && (bytes.back() & 0x80) != 0) {
-    raw |= ~std::uint64_t{0} << (8 * bytes.size());
-  }
-  return static_cast<std::int64_t>(raw);
-}
-
 // -1, 0, 1 as a < b, a == b, a > b for two values of `entry`'s type.
 int compare(const IdnEntry& entry, ConstBytes a, ConstBytes b) {
   if (entry.attribute.dataType() == SoeDataType::kSigned) {
-    const auto x = asNumber(a, true);
-    const auto y = asNumber(b, true);
+    const auto x = soeNumber(a, true);
+    const auto y = soeNumber(b, true);
     return x < y ? -1 : x > y ? 1 : 0;
   }
-  const auto x = static_cast<std::uint64_t>(asNumber(a, false));
-  const auto y = static_cast<std::uint64_t>(asNumber(b, false));
+  const auto x = static_cast<std::uint64_t>(soeNumber(a, false));
+  const auto y = static_cast<std::uint64_t>(soeNumber(b, false));
   return x < y ? -1 : x > y ? 1 : 0;
 }
 

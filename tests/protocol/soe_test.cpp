@@ -156,5 +156,18 @@ TEST(SoeElements, SplitsAReadResponseInElementOrder) {
   EXPECT_NE(cut.error().context.find("runs past"), std::string::npos);
 }
 
+// The value of one element, as the server compares it with its limits and ecmaster shows it.
+TEST(SoeNumber, LittleEndianAndSignExtendedOnlyWhenSigned) {
+  const std::vector<std::uint8_t> minus2{0xFE, 0xFF};
+  EXPECT_EQ(soeNumber(minus2, true), -2);
+  EXPECT_EQ(soeNumber(minus2, false), 0xFFFE);
+  const std::vector<std::uint8_t> four{0x78, 0x56, 0x34, 0x12};
+  EXPECT_EQ(soeNumber(four, true), 0x12345678);
+  const std::vector<std::uint8_t> eight(8, 0xFF);
+  EXPECT_EQ(soeNumber(eight, true), -1);
+  EXPECT_EQ(static_cast<std::uint64_t>(soeNumber(eight, false)), ~std::uint64_t{0});
+  EXPECT_EQ(soeNumber(ConstBytes{}, true), 0);
+}
+
 }  // namespace
 }  // namespace ecsim

@@ -28,25 +28,14 @@ constexpr std::uint8_t kAllElements =
     soe_element::kName | soe_element::kAttribute | soe_element::kUnit | soe_element::kMinimum |
     soe_element::kMaximum | soe_element::kValue | soe_element::kDefault;
 
-std::int64_t number(ConstBytes bytes, bool isSigned) {
-  std::uint64_t raw = 0;
-  for (std::size_t i = 0; i < bytes.size() && i < 8; ++i) {
-    raw |= static_cast<std::uint64_t>(bytes[i]) << (8 * i);
-  }
-  if (isSigned && bytes.size() < 8 && !bytes.empty() && (bytes.back() & 0x80) != 0) {
-    raw |= ~std::uint64_t{0} << (8 * bytes.size());
-  }
-  return static_cast<std::int64_t>(raw);
-}
-
 // One element (of an element size) as the attribute's data type shows it.
 std::string formatElement(SoeAttribute a, ConstBytes bytes) {
   switch (a.dataType()) {
     case SoeDataType::kIdn:
-      return formatIdn(static_cast<std::uint16_t>(number(bytes, false)));
+      return formatIdn(static_cast<std::uint16_t>(soeNumber(bytes, false)));
     case SoeDataType::kHex:
     case SoeDataType::kBinary:
-      return hex(static_cast<std::uint64_t>(number(bytes, false)),
+      return hex(static_cast<std::uint64_t>(soeNumber(bytes, false)),
                  static_cast<int>(2 * bytes.size()));
     case SoeDataType::kText:
       return std::string(1, static_cast<char>(bytes[0]));
@@ -54,7 +43,7 @@ std::string formatElement(SoeAttribute a, ConstBytes bytes) {
       break;
   }
   const bool isSigned = a.dataType() == SoeDataType::kSigned;
-  const std::int64_t v = number(bytes, isSigned);
+  const std::int64_t v = soeNumber(bytes, isSigned);
   if (a.decimals() == 0) {
     return isSigned ? std::to_string(v) : std::to_string(static_cast<std::uint64_t>(v));
   }
