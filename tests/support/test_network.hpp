@@ -13,6 +13,7 @@
 
 #include "protocol/frame.hpp"
 #include "protocol/sii.hpp"
+#include "tests/support/ci_mode.hpp"
 #include "topology/segment.hpp"
 
 namespace ecsim::testing {
@@ -106,11 +107,8 @@ struct DatagramResult {
   std::uint16_t irq;  // the ORed ECAT event requests of the ESCs passed (0x0200/0x0210)
 };
 
-// Sends one frame with the given datagrams through the segment, runs the slaves' firmware
-// (unless `firmware` is false: ESC only) and returns each datagram as it came back.
-inline std::vector<DatagramResult> exchange(topology::Segment& seg,
-                                            const std::vector<DatagramSpec>& specs,
-                                            SimTime now = 0, bool firmware = true) {
+// One Ethernet frame holding the given datagrams (indexes 0, 1, ...), broadcast.
+inline std::vector<std::uint8_t> buildFrame(const std::vector<DatagramSpec>& specs) {
   std::array<std::uint8_t, kMaxFrameSize> buf{};
   FrameBuilder b(
       buf, EthernetHeader{kBroadcastMac, {1, 1, 1, 1, 1, 1}, std::nullopt, kEtherTypeEtherCat});
@@ -121,16 +119,24 @@ inline std::vector<DatagramResult> exchange(topology::Segment& seg,
   }
   auto len = b.finish();
   EXPECT_TRUE(len.ok());
-  auto outcome = seg.processFrame(std::span(buf.data(), *len), now);
+  return {buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(len.ok() ? *len : 0)};
+}
+
+// Sends one frame with the given datagrams through the segment, runs the slaves' firmware
+// (unless `firmware` is false: ESC only) and returns each datagram as it came back.
+inline std::vector<DatagramResult> exchange(topology::Segment& seg,
+                                            const std::vector<DatagramSpec>& specs, SimTime now = 0,
+                                            bool firmware = true) {
+  std::vector<std::uint8_t> buf = buildFrame(specs);
+  auto outcome = seg.processFrame(std::span(buf.data(), buf.size()), now);
   EXPECT_TRUE(outcome.delivered);
   if (firmware) seg.pollSlaves(now);
   std::vector<DatagramResult> out;
-  auto frame = EtherCatFrame::parse(std::span(buf.data(), *len));
+  auto frame = EtherCatFrame::parse(std::span(buf.data(), buf.size()));
   EXPECT_TRUE(frame.ok());
   for (auto d : *frame) {
     out.push_back({d.command(), d.adp(), d.ado(), d.address(),
-                   std::vector<std::uint8_t>(d.data().begin(), d.data().end()), d.wkc(),
-                   d.irq()});
+                   std::vector<std::uint8_t>(d.data().begin(), d.data().end()), d.wkc(), d.irq()});
   }
   return out;
 }
@@ -151,11 +157,6 @@ inline std::vector<std::uint8_t> le16(std::uint16_t v) {
 // Path to the shared test corpus; under CI=true a missing corpus is a failure.
 inline std::filesystem::path sharedDir() {
   return std::filesystem::path(ECSIM_SHARED_DIR);
-}
-
-inline bool ciMode() {
-  const char* ci = std::getenv("CI");
-  return ci != nullptr && std::string(ci) == "true";
 }
 
 // In a test body: fail under CI=true, otherwise skip with a reason, when path is missing.

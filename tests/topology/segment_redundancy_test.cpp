@@ -29,17 +29,6 @@ struct Sent {
   }
 };
 
-std::vector<std::uint8_t> frameOf(const std::vector<DatagramSpec>& specs) {
-  std::array<std::uint8_t, kMaxFrameSize> buf{};
-  FrameBuilder b(
-      buf, EthernetHeader{kBroadcastMac, {1, 1, 1, 1, 1, 1}, std::nullopt, kEtherTypeEtherCat});
-  std::uint8_t idx = 0;
-  for (const auto& s : specs) EXPECT_TRUE(b.add(s.command, idx++, s.address, s.data).ok());
-  auto len = b.finish();
-  EXPECT_TRUE(len.ok());
-  return {buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(*len)};
-}
-
 Sent send(topology::Segment& seg, std::vector<std::uint8_t> frame, MasterPort from) {
   Sent s;
   s.outcome = seg.processFrame(std::span(frame.data(), frame.size()), 0, from);
@@ -58,7 +47,7 @@ class Ring : public ::testing::Test {
     seg_.setLinkUp(a, 1, false);
     seg_.setLinkUp(b, 0, false);
   }
-  std::vector<std::uint8_t> brd() { return frameOf({{Command::kBrd, 0, {0, 0}}}); }
+  std::vector<std::uint8_t> brd() { return buildFrame({{Command::kBrd, 0, {0, 0}}}); }
   topology::Segment seg_;
 };
 
@@ -106,7 +95,7 @@ TEST_F(Ring, AutoIncrementCountsOnAcrossTheBreak) {
   // frame sent again from the second port passes 5, 4, 3 unprocessed, loops at slave 3, whose
   // processing unit counts it to 0, so slave 4 writes.
   const auto apwr =
-      frameOf({{Command::kApwr, phys(static_cast<std::uint16_t>(-4), 0x0010), le16(0x1234)}});
+      buildFrame({{Command::kApwr, phys(static_cast<std::uint16_t>(-4), 0x0010), le16(0x1234)}});
   Sent primary = send(seg_, apwr, MasterPort::kPrimary);
   EXPECT_EQ(primary.wkc(), 0);
   Sent combined = send(seg_, primary.frame, MasterPort::kSecondary);
@@ -133,7 +122,7 @@ TEST(RedundantPort, RefusedWhereACableIsAndDroppedWithoutOne) {
   EXPECT_FALSE(seg.setRedundantPort(1, 1).ok()) << "slave 1 port 1 is wired to slave 2";
   EXPECT_FALSE(seg.setRedundantPort(0, 0).ok()) << "the primary's own port";
   EXPECT_FALSE(seg.setRedundantPort(3, 1).ok()) << "no such slave";
-  auto f = frameOf({{Command::kBrd, 0, {0, 0}}});
+  auto f = buildFrame({{Command::kBrd, 0, {0, 0}}});
   EXPECT_FALSE(seg.processFrame(std::span(f.data(), f.size()), 0, MasterPort::kSecondary).delivered)
       << "a master without redundancy has no second port";
   EXPECT_EQ(seg.counters().framesMalformed, 0u);
