@@ -40,6 +40,7 @@
 #include "link/signal_flag.hpp"
 #include "protocol/frame.hpp"
 #include "slavesim/generic_slave.hpp"
+#include "tests/support/ci_mode.hpp"
 #include "topology/segment.hpp"
 
 namespace ecsim {
@@ -304,9 +305,8 @@ int run(int argc, char** argv) {
   }
   const Options& o = *parsed;
   if (auto caps = checkNetworkCapabilities(); !caps.ok()) {
-    const char* ci = std::getenv("CI");
     fmt::print(stderr, "floor_bench: needs network privileges: {}\n", caps.error().message());
-    return ci != nullptr && std::string(ci) == "true" ? 1 : kSkip;
+    return ecsim::testing::ciMode() ? 1 : kSkip;
   }
   SignalFlag stop;
   auto ns = VethNamespace::create();

@@ -11,16 +11,12 @@
 #include <iterator>
 #include <string>
 #include <vector>
+#include "tests/support/ci_mode.hpp"
 
 namespace ecsim::testdata {
 
 inline std::filesystem::path sharedPath(const char* sub) {
   return std::filesystem::path(ECSIM_SHARED_DIR) / sub;
-}
-
-inline bool ciRequiresData() {
-  const char* ci = std::getenv("CI");
-  return ci != nullptr && std::string(ci) == "true";
 }
 
 inline std::vector<std::uint8_t> readBytes(const std::filesystem::path& path) {
@@ -32,9 +28,9 @@ inline std::vector<std::uint8_t> readBytes(const std::filesystem::path& path) {
 
 // Declares `var` as the path of `file` under ECSIM_SHARED_DIR/`sub`; skips or fails the test
 // when it does not exist.
-#define ECSIM_REQUIRE_SHARED_FILE(var, sub, file)                                      \
-  const std::filesystem::path var = ::ecsim::testdata::sharedPath(sub) / (file);       \
-  if (!std::filesystem::exists(var)) {                                                 \
-    if (::ecsim::testdata::ciRequiresData()) FAIL() << "CI=true but missing: " << var; \
-    GTEST_SKIP() << "reference data not present: " << var;                             \
+#define ECSIM_REQUIRE_SHARED_FILE(var, sub, file)                                \
+  const std::filesystem::path var = ::ecsim::testdata::sharedPath(sub) / (file); \
+  if (!std::filesystem::exists(var)) {                                           \
+    if (::ecsim::testing::ciMode()) FAIL() << "CI=true but missing: " << var;    \
+    GTEST_SKIP() << "reference data not present: " << var;                       \
   }

@@ -141,7 +141,7 @@ TEST(RealTime, SpawnPriorityReachesTheProgramAndTheThreadGetsItsPolicyBack) {
   {
     RealTimeThread rt(30);
     if (!rt.ok()) {
-      if (::ecsim::testing::inCi()) FAIL() << "CI=true and SCHED_FIFO " << rt.note();
+      if (::ecsim::testing::ciMode()) FAIL() << "CI=true and SCHED_FIFO " << rt.note();
       GTEST_SKIP() << "SCHED_FIFO " << rt.note();
     }
     EXPECT_EQ(sched_getscheduler(0), SCHED_FIFO);

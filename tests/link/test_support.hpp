@@ -16,21 +16,17 @@
 
 #include "link/netns.hpp"
 #include "protocol/frame.hpp"
+#include "tests/support/ci_mode.hpp"
 
 namespace ecsim::testing {
 
-inline bool inCi() {
-  const char* ci = std::getenv("CI");
-  return ci != nullptr && std::string(ci) == "true";
-}
-
 // A prerequisite is missing: a failure under CI=true, otherwise a skip with the reason.
-#define ECSIM_REQUIRE_OR_SKIP(condition, reason)                          \
-  do {                                                                    \
-    if (!(condition)) {                                                   \
-      if (::ecsim::testing::inCi()) FAIL() << "CI=true and " << (reason); \
-      GTEST_SKIP() << (reason);                                           \
-    }                                                                     \
+#define ECSIM_REQUIRE_OR_SKIP(condition, reason)                            \
+  do {                                                                      \
+    if (!(condition)) {                                                     \
+      if (::ecsim::testing::ciMode()) FAIL() << "CI=true and " << (reason); \
+      GTEST_SKIP() << (reason);                                             \
+    }                                                                       \
   } while (false)
 
 #define ECSIM_REQUIRE_NETWORK_PRIVILEGES()                                        \

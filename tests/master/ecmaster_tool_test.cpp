@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "link/netns.hpp"
+#include "tests/support/ci_mode.hpp"
 
 namespace ecsim::testing {
 namespace {
@@ -170,8 +171,8 @@ TEST(EcmasterTool, EniValuesIgnoredAreWarnedAbout) {
   const auto at = eni.find(cycle);
   ASSERT_NE(at, std::string::npos);
   eni.replace(at, cycle.size(), "<CycleTime>0</CycleTime>");
-  const std::string path = ::testing::TempDir() + "ecmaster_odd_eni_" +
-                           std::to_string(::getpid()) + ".xml";
+  const std::string path =
+      ::testing::TempDir() + "ecmaster_odd_eni_" + std::to_string(::getpid()) + ".xml";
   std::ofstream(path) << eni;
   auto out = run({"--sim", kDemo, "--config", path, "slaves"});
   std::remove(path.c_str());
@@ -195,16 +196,18 @@ TEST(EcmasterTool, UsageErrors) {
 TEST(EcmasterTool, FoeWriteInBootAndReadOfAMissingFile) {
   const std::string esi = std::string(ECSIM_SHARED_DIR) + "/esi/SOES_lan9252demo_slave.xml";
   if (!std::ifstream(esi)) {
-    const char* ci = std::getenv("CI");
-    if (ci != nullptr && std::string(ci) == "true") FAIL() << "CI=true and " << esi << " missing";
+    if (ciMode()) FAIL() << "CI=true and " << esi << " missing";
     GTEST_SKIP() << esi << " missing";
   }
-  const std::string topology = ::testing::TempDir() + "foe_tool_" + std::to_string(::getpid()) + ".xml";
+  const std::string topology =
+      ::testing::TempDir() + "foe_tool_" + std::to_string(::getpid()) + ".xml";
   std::ofstream(topology) << "<Topology name=\"foe\">\n  <Slave name=\"Soes\" esi=\"" << esi
                           << "\" product=\"#x4D2\"/>\n</Topology>\n";
-  const std::string image = ::testing::TempDir() + "foe_tool_" + std::to_string(::getpid()) + ".bin";
+  const std::string image =
+      ::testing::TempDir() + "foe_tool_" + std::to_string(::getpid()) + ".bin";
   std::ofstream(image, std::ios::binary) << std::string(300, 'x');
-  auto j = json(run({"--sim", topology, "--json", "foe", "write", "--boot", image, "-n", "fw.bin"}));
+  auto j =
+      json(run({"--sim", topology, "--json", "foe", "write", "--boot", image, "-n", "fw.bin"}));
   EXPECT_EQ(j["bytes"], 300);
   EXPECT_EQ(j["boot"], true);
   auto missing = run({"--sim", topology, "foe", "read", "--boot", "nothing.bin"});

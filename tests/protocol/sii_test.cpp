@@ -11,6 +11,7 @@
 #include <ostream>
 #include <string>
 #include <vector>
+#include "tests/support/ci_mode.hpp"
 
 namespace ecsim {
 namespace {
@@ -24,16 +25,12 @@ fs::path eepromDir() {
   return fs::is_directory(dir) ? dir : fs::path{};
 }
 
-bool ciRequiresData() {
-  const char* ci = std::getenv("CI");
-  return ci != nullptr && std::string(ci) == "true";
-}
-
-#define REQUIRE_EEPROM_DIR(dir)                                                           \
-  const fs::path dir = eepromDir();                                                       \
-  if (dir.empty()) {                                                                      \
-    if (ciRequiresData()) FAIL() << "CI=true but " ECSIM_SHARED_DIR "/eeprom is missing"; \
-    GTEST_SKIP() << "reference data " ECSIM_SHARED_DIR "/eeprom not present";             \
+#define REQUIRE_EEPROM_DIR(dir)                                               \
+  const fs::path dir = eepromDir();                                           \
+  if (dir.empty()) {                                                          \
+    if (::ecsim::testing::ciMode())                                           \
+      FAIL() << "CI=true but " ECSIM_SHARED_DIR "/eeprom is missing";         \
+    GTEST_SKIP() << "reference data " ECSIM_SHARED_DIR "/eeprom not present"; \
   }
 
 std::vector<std::uint8_t> readFile(const fs::path& path) {

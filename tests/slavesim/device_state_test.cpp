@@ -34,7 +34,9 @@ class StateFileSafety : public TempDir {
   }
 };
 
-std::string errorOf(const Status& s) { return s.ok() ? "(saved)" : s.error().context; }
+std::string errorOf(const Status& s) {
+  return s.ok() ? "(saved)" : s.error().context;
+}
 
 TEST_F(StateFileSafety, AFifoIsRefusedAndLeftAFifo) {
   const auto fifo = dir_ / "drive.state";
@@ -55,7 +57,7 @@ TEST_F(StateFileSafety, ADeviceNodeIsRefusedAndLeftADeviceNode) {
   // A /dev/zero of our own (major 1, minor 5) in the temporary folder; /dev is not touched.
   const auto node = dir_ / "zero";
   if (::mknod(node.c_str(), S_IFCHR | 0600, makedev(1, 5)) != 0) {
-    if (ciModeForPrivileges()) FAIL() << "CI=true and mknod needs CAP_MKNOD";
+    if (ciMode()) FAIL() << "CI=true and mknod needs CAP_MKNOD";
     GTEST_SKIP() << "mknod needs CAP_MKNOD";
   }
   const Status saved = dev::saveDeviceState(node, {1.0});
@@ -101,8 +103,7 @@ TEST_F(StateFileSafety, AFileThatIsNotAStateFileIsRefusedAndKept) {
   const auto big = dir_ / "big";
   std::ofstream(big) << std::string(1 << 20, 'x');
   const Status bigSaved = dev::saveDeviceState(big, {1.0});
-  EXPECT_NE(errorOf(bigSaved).find("more than 4096 bytes"), std::string::npos)
-      << errorOf(bigSaved);
+  EXPECT_NE(errorOf(bigSaved).find("more than 4096 bytes"), std::string::npos) << errorOf(bigSaved);
   EXPECT_EQ(std::filesystem::file_size(big), 1u << 20);
 }
 

@@ -16,6 +16,7 @@
 #include "slavesim/esi_slave.hpp"
 #include "support/test_network.hpp"
 #include "tests/slavesim/one_slave_topology.hpp"
+#include "tests/support/ci_mode.hpp"
 
 namespace ecsim::testing {
 namespace {
@@ -58,10 +59,6 @@ class IoProfile : public OneSlaveTopology {
       GTEST_SKIP() << "../shared/esi is missing";
     }
   }
-  static bool ciMode() {
-    const char* ci = std::getenv("CI");
-    return ci != nullptr && std::string(ci) == "true";
-  }
 };
 
 TEST_F(IoProfile, ChosenFromTheDevicesOwnPdos) {
@@ -93,8 +90,8 @@ TEST_F(IoProfile, EcsimsOwnDevicesKeepTheirModels) {
 }
 
 TEST_F(IoProfile, OldLayoutStatusByteShowsRangeBits) {
-  auto net = build(write(slave("AI", kEl3102, {},
-                               "    <Param name=\"signal.2\" value=\"constant value=-11\"/>\n")));
+  auto net = build(write(
+      slave("AI", kEl3102, {}, "    <Param name=\"signal.2\" value=\"constant value=-11\"/>\n")));
   ASSERT_TRUE(net.ok()) << net.error().message();
   auto& s = net->segment->slave(0);
   auto* od = slavesim::objectDictionaryOf(s);
@@ -167,16 +164,20 @@ TEST_F(IoProfile, BadModelsAndWiringAreErrorsWithFileAndLine) {
            slave("DI", kEl1004, {},
                  "    <Param name=\"signal.1\" value=\"output slave=DO1 channel=9\"/>\n"),
        {"net.xml", "line 5", "has output channels 1..4, not 9"}},
-      {"loopback without loopback.from", slave("DI", kEl1004, " model=\"loopback\""),
+      {"loopback without loopback.from",
+       slave("DI", kEl1004, " model=\"loopback\""),
        {"line 2", "loopback.from"}},
       {"loopback.from on another model",
        slave("DO1", kEl2004) + slave("DI", kEl1004, " model=\"io\"", loopFrom + "DO1\"/>\n"),
        {"line 5", "loopback.from needs model=\"loopback\""}},
-      {"io on a coupler", slave("C", kEk1100, " model=\"io\""),
+      {"io on a coupler",
+       slave("C", kEk1100, " model=\"io\""),
        {"net.xml", "line 2", "profile io", "no digital entries"}},
-      {"analog on a digital input terminal", slave("DI", kEl1004, " model=\"analog\""),
+      {"analog on a digital input terminal",
+       slave("DI", kEl1004, " model=\"analog\""),
        {"line 2", "profile analog"}},
-      {"misspelt model", slave("DI", kEl1004, " model=\"loopbak\""),
+      {"misspelt model",
+       slave("DI", kEl1004, " model=\"loopbak\""),
        {"line 2", "did you mean 'loopback'?"}},
   };
   for (const ErrorCase& c : cases) {
@@ -192,9 +193,9 @@ TEST_F(IoProfile, BadModelsAndWiringAreErrorsWithFileAndLine) {
 // A power cycle re-creates both models (devices::restartDeviceModel): the wiring is outside
 // the devices and survives, and follows the new output terminal.
 TEST_F(IoProfile, LoopbackSurvivesPowerCyclesOfBothSlaves) {
-  auto net = build(write(slave("DO", kEl2004) +
-                         slave("DI", kEl1004, " model=\"loopback\"",
-                               "    <Param name=\"loopback.from\" value=\"DO\"/>\n")));
+  auto net = build(
+      write(slave("DO", kEl2004) + slave("DI", kEl1004, " model=\"loopback\"",
+                                         "    <Param name=\"loopback.from\" value=\"DO\"/>\n")));
   ASSERT_TRUE(net.ok()) << net.error().message();
   auto& out = net->segment->slave(0);
   auto& in = net->segment->slave(1);

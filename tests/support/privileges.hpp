@@ -4,25 +4,15 @@
 
 #include <gtest/gtest.h>
 
-#include <cstdlib>
 #include <string>
 
 #include "link/netns.hpp"
+#include "tests/support/ci_mode.hpp"
 
-namespace ecsim::testing {
-
-inline bool ciModeForPrivileges() {
-  const char* ci = std::getenv("CI");
-  return ci != nullptr && std::string(ci) == "true";
-}
-
-}  // namespace ecsim::testing
-
-#define ECSIM_REQUIRE_NETWORK()                                               \
-  do {                                                                        \
-    if (auto caps = ::ecsim::checkNetworkCapabilities(); !caps.ok()) {        \
-      if (::ecsim::testing::ciModeForPrivileges())                            \
-        FAIL() << "CI=true and " << caps.error().message();                   \
-      GTEST_SKIP() << "needs network privileges: " << caps.error().message(); \
-    }                                                                         \
+#define ECSIM_REQUIRE_NETWORK()                                                           \
+  do {                                                                                    \
+    if (auto caps = ::ecsim::checkNetworkCapabilities(); !caps.ok()) {                    \
+      if (::ecsim::testing::ciMode()) FAIL() << "CI=true and " << caps.error().message(); \
+      GTEST_SKIP() << "needs network privileges: " << caps.error().message();             \
+    }                                                                                     \
   } while (false)
