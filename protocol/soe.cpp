@@ -134,7 +134,7 @@ Result<std::uint16_t> parseIdn(std::string_view text) {
                    unsigned long max) -> std::optional<unsigned long> {
     unsigned long v = 0;
     if (s.empty()) return std::nullopt;
-    auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v, base);
+    auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v, static_cast<int>(base));
     if (ec != std::errc{} || p != s.data() + s.size() || v > max) return std::nullopt;
     return v;
   };
@@ -357,7 +357,8 @@ Result<SoeElements> splitSoeElements(std::uint8_t elements, ConstBytes data,
     ECSIM_TRY(need(kSoeListHeaderSize, what));
     const std::size_t n = kSoeListHeaderSize + readLe16(data, at);
     ECSIM_TRY(need(n, what));
-    std::vector<std::uint8_t> v(data.begin() + at, data.begin() + at + n);
+    const ConstBytes slice = data.subspan(at, n);
+    std::vector<std::uint8_t> v(slice.begin(), slice.end());
     at += n;
     return v;
   };
@@ -369,7 +370,8 @@ Result<SoeElements> splitSoeElements(std::uint8_t elements, ConstBytes data,
     if (out.attribute.isList()) return list(what);
     const std::size_t n = out.attribute.elementSize();
     ECSIM_TRY(need(n, what));
-    std::vector<std::uint8_t> v(data.begin() + at, data.begin() + at + n);
+    const ConstBytes slice = data.subspan(at, n);
+    std::vector<std::uint8_t> v(slice.begin(), slice.end());
     at += n;
     return v;
   };
