@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <functional>
 
 #include "master/master.hpp"
 #include "protocol/frame.hpp"
@@ -19,6 +20,14 @@ namespace {
 using master::Master;
 
 constexpr SimTime kEscDelay = 1000;  // processing = forwarding, set on every slave below
+
+// A static drift frame (one FRMW of the reference's 0x0910, alone in its frame) answered.
+bool isDriftAnswer(ConstBytes frame) {
+  auto f = ConstEtherCatFrame::parse(frame);
+  if (!f.ok() || f->datagramCount() != 1) return false;
+  const auto d = *f->begin();
+  return d.command() == Command::kFrmw && d.ado() == reg::kSystemTime.address;
+}
 
 class DcMasterTest : public ::testing::Test {
  protected:
@@ -35,6 +44,20 @@ class DcMasterTest : public ::testing::Test {
     net_.start();
     master_ = std::make_unique<Master>(net_.masterLink(), net_.bus(), options);
   }
+  // start() on a line of three with 200 static drift frames; the n-th answer to a drift frame
+  // (every try counts, driftAnswers_) is dropped when drop(n) says so.
+  Status startDroppingDriftAnswers(std::function<bool(std::uint64_t)> drop) {
+    addIo(3);
+    net_.segment().wireLine(1.0);
+    net_.fault().dropReceiveIf = [this, drop = std::move(drop)](ConstBytes frame) {
+      return isDriftAnswer(frame) && drop(++driftAnswers_);
+    };
+    master::MasterOptions options;
+    options.dc.enable = true;
+    options.dc.staticDriftFrames = 200;
+    build(options);
+    return master_->start();
+  }
   slavesim::Slave& sim(std::size_t i) { return net_.segment().slave(i); }
   void expectDelays(const std::vector<SimTime>& model) {
     const auto& setup = master_->dcSetup();
@@ -50,6 +73,7 @@ class DcMasterTest : public ::testing::Test {
 
   SimNetwork net_;
   std::unique_ptr<Master> master_;
+  std::uint64_t driftAnswers_{0};
 };
 
 TEST_F(DcMasterTest, LineDelaysEqualTheModel) {
@@ -145,50 +169,23 @@ TEST_F(DcMasterTest, DriftCompensationHoldsEveryDifferenceBelow100nsFor10Seconds
   }
 }
 
-// A static drift frame (one FRMW of the reference's 0x0910, alone in its frame) answered.
-bool isDriftAnswer(ConstBytes frame) {
-  auto f = ConstEtherCatFrame::parse(frame);
-  if (!f.ok() || f->datagramCount() != 1) return false;
-  const auto d = *f->begin();
-  return d.command() == Command::kFrmw && d.ado() == reg::kSystemTime.address;
-}
-
 // A static drift FRMW only nudges the drift filters: one lost after every retry (the answers
 // to its three tries dropped) is counted and the set-up goes on, as a master does with a lost
 // cyclic FRMW. Before, one such frame of 15,000 failed start() (a CI run over veth, where a
 // wake-up of an idle virtual CPU took 8.6 ms, longer than the 3 x 2 ms of tries).
 TEST_F(DcMasterTest, OneLostStaticDriftFrameIsCountedAndTheSetUpGoesOn) {
-  addIo(3);
-  net_.segment().wireLine(1.0);
-  master::MasterOptions options;
-  options.dc.enable = true;
-  options.dc.staticDriftFrames = 200;
-  std::uint64_t driftAnswers = 0;
-  net_.fault().dropReceiveIf = [&](ConstBytes frame) {
-    if (!isDriftAnswer(frame)) return false;
-    ++driftAnswers;
-    return driftAnswers >= 50 && driftAnswers < 53;  // the 50th frame's three tries
-  };
-  build(options);
-  auto status = master_->start();
+  auto status = startDroppingDriftAnswers([](std::uint64_t n) {
+    return n >= 50 && n < 53;  // the 50th frame's three tries
+  });
   ASSERT_TRUE(status.ok()) << status.error().message();
   EXPECT_EQ(master_->dcSetup().driftFramesLost, 1u);
   EXPECT_EQ(net_.fault().droppedReceives, 3u);
-  EXPECT_EQ(driftAnswers, 202u);  // 199 frames answered, one answered three times and dropped
+  EXPECT_EQ(driftAnswers_, 202u);  // 199 frames answered, one answered three times and dropped
 }
 
 TEST_F(DcMasterTest, StaticDriftFramesLostInARowFailTheSetUp) {
-  addIo(3);
-  net_.segment().wireLine(1.0);
-  master::MasterOptions options;
-  options.dc.enable = true;
-  options.dc.staticDriftFrames = 200;
-  std::uint64_t driftAnswers = 0;
-  net_.fault().dropReceiveIf = [&](ConstBytes frame) {
-    return isDriftAnswer(frame) && ++driftAnswers >= 50;  // the reference is gone
-  };
-  build(options);
-  auto status = master_->start();
+  auto status =
+      startDroppingDriftAnswers([](std::uint64_t n) { return n >= 50; });  // the reference is gone
   ASSERT_FALSE(status.ok());
   EXPECT_NE(status.error().message().find("3 static drift frames lost in a row (3 of 52 sent)"),
             std::string::npos)
