@@ -31,7 +31,7 @@ struct SpawnOptions {
   std::string stdoutPath;
   std::string stderrPath;  // may equal stdoutPath: both streams then share the file
   // SCHED_FIFO priority of the child (and of what it starts); 0: the caller's policy. Needs
-  // root or CAP_SYS_NICE (RealTimeThread::permitted()); without it the spawn fails.
+  // root or CAP_SYS_NICE (a RealTimeThread's ok() tells); without it the spawn fails (EPERM).
   int fifoPriority{0};
 };
 
