@@ -9,7 +9,10 @@
  * usage: io_client IFNAME CYCLES
  * prints: "slaves N", one "slave S name NAME ibits I obits O" per slave, "op" once every slave
  *         is in OP (else "not in OP: slave S state 0xSS" lines and exit 4), then per cycle C
- *         and slave S with process data one line "c C s S out HEX in HEX" (HEX: the slave's
+ *         one line "t C SENT RECEIVED" (CLOCK_MONOTONIC in microseconds just before the
+ *         process data frame was sent and just after its answer came back: whatever a slave
+ *         sampled for cycle C, it sampled between the two) and per slave S with process data
+ *         one line "c C s S out HEX in HEX" (HEX: the slave's
  *         bits packed from bit 0, byte 0 first, two digits a byte; "-" when it has none),
  *         "done cycles C wkc-errors E" at the end.
  * The output pattern of slave S in cycle C, byte k: (C * 7 + S * 31 + k * 17) & 0xFF, cut to
@@ -19,6 +22,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #ifdef SOEM_V2
 #include "soem/soem.h"
@@ -54,6 +58,13 @@ static ecx_contextt ctx;
 #endif
 
 static char io_map[8192];
+
+static long long monotonic_us(void)
+{
+   struct timespec t;
+   clock_gettime(CLOCK_MONOTONIC, &t);
+   return (long long)t.tv_sec * 1000000LL + t.tv_nsec / 1000;
+}
 
 /* Bit `bit` of the field starting at `base` + `start` bits. */
 static int get_bit(const uint8 *base, unsigned start, unsigned bit)
@@ -155,8 +166,10 @@ int main(int argc, char *argv[])
    for (int c = 0; c < cycles; c++)
    {
       for (int s = 1; s <= SLAVECOUNT; s++) write_pattern(s, c);
+      const long long sent = monotonic_us();
       SEND();
       if (RECEIVE() < expected_wkc) wkc_errors++;
+      printf("t %d %lld %lld\n", c, sent, monotonic_us());
       for (int s = 1; s <= SLAVECOUNT; s++)
       {
          if (SLAVE(s).Obits == 0 && SLAVE(s).Ibits == 0) continue;

@@ -6,13 +6,16 @@
 // that changes every cycle into every output and prints its process image every cycle:
 //   - digital inputs follow their script (a 100 ms square on every channel): each device's
 //     input bits alternate between two values that differ in exactly its channel count of bits,
-//     in runs of about 50 cycles;
+//     and each change comes 50 ms after the one before, by SOEM's own clock (the client
+//     prints when each cycle's frame left and came back; how many cycles fit in 50 ms is the
+//     host's business, not the simulator's);
 //   - analog inputs follow theirs (a 100 ms square between 2.5 V and -5 V: raw 0x2000 and
 //     0xC000 at +/-10 V full scale, docs/devices.md);
 //   - the EL1004's inputs show what SOEM wrote to the EL2004's outputs one cycle later.
 // The in-process counterpart with our master is tests/embed/vendor_io_test.cpp.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <fstream>
 #include <map>
@@ -30,9 +33,13 @@ namespace {
 constexpr int kCycles = 400;
 constexpr std::chrono::seconds kClientTimeout{90};
 constexpr int kSkip = 5;  // first cycles: the scripts' first edge and OP's first exchange
+constexpr long long kHalfPeriodUs = 50'000;  // the scripts' squares: period=0.1
+// Microsecond timestamps, rounded down: a few microseconds either way.
+constexpr long long kSlackUs = 4;
 
 struct Image {
   std::map<int, std::vector<std::string>> in, out;  // per SOEM slave (1-based), per cycle
+  std::vector<long long> sent, received;            // per cycle, CLOCK_MONOTONIC in us
 };
 
 Image parse(const std::string& text) {
@@ -40,8 +47,14 @@ Image parse(const std::string& text) {
   std::istringstream lines(text);
   std::string line;
   const std::regex row("^c ([0-9]+) s ([0-9]+) out ([-0-9a-f]+) in ([-0-9a-f]+)$");
+  const std::regex times("^t ([0-9]+) ([0-9]+) ([0-9]+)$");
   std::smatch m;
   while (std::getline(lines, line)) {
+    if (std::regex_match(line, m, times)) {
+      image.sent.push_back(std::stoll(m[2]));
+      image.received.push_back(std::stoll(m[3]));
+      continue;
+    }
     if (!std::regex_match(line, m, row)) continue;
     const int slave = std::stoi(m[2]);
     image.out[slave].push_back(m[3]);
@@ -67,19 +80,25 @@ unsigned wordsEqual(const std::string& hex, const std::string& le) {
   return n;
 }
 
-// Lengths of the runs of equal values after kSkip, without the first and the last (cut off).
-std::vector<int> innerRuns(const std::vector<std::string>& values) {
-  std::vector<int> runs;
-  int length = 0;
+// The cycles after kSkip whose inputs differ from the cycle's before: the square's edges.
+std::vector<std::size_t> edges(const std::vector<std::string>& values) {
+  std::vector<std::size_t> at;
   for (std::size_t c = kSkip + 1; c < values.size(); ++c) {
-    ++length;
-    if (values[c] != values[c - 1]) {
-      runs.push_back(length);
-      length = 0;
-    }
+    if (values[c] != values[c - 1]) at.push_back(c);
   }
-  if (!runs.empty()) runs.erase(runs.begin());
-  return runs;
+  return at;
+}
+
+// `ecsim serve` runs its firmware (which sets the inputs from their scripts) after answering
+// each frame, so the inputs a frame reads were set after the frame before it was answered. An
+// edge first seen in cycle k therefore happened after the firmware run behind cycle k-1 (which
+// was after cycle k-2's frame left) and before cycle k's answer came back: in (sent[k-2],
+// received[k]). The time between the edges seen in cycles j < k lies in (sent[k-2] -
+// received[j], received[k] - sent[j-2]). How far outside that interval `us` lies (0: inside).
+long long outside(const Image& image, std::size_t j, std::size_t k, long long us) {
+  const long long least = image.sent[k - 2] - image.received[j];
+  const long long most = image.received[k] - image.sent[j - 2];
+  return us < least ? least - us : us > most ? us - most : 0;
 }
 
 std::string topology() {
@@ -137,6 +156,8 @@ TEST_P(SoemIo, InputsFollowTheirScriptsAndALoopbackShowsTheOutputsOneCycleLater)
   ASSERT_NE(out.find("\ndone cycles"), std::string::npos)
       << out.substr(out.size() > 3000 ? out.size() - 3000 : 0);
   const Image image = parse(out);
+  ASSERT_EQ(image.sent.size(), static_cast<std::size_t>(kCycles));
+  long long worst = 0;
 
   for (std::size_t i = 0; i < devices; ++i) {
     const VendorIoDevice& d = kVendorIoDevices[i];
@@ -158,14 +179,19 @@ TEST_P(SoemIo, InputsFollowTheirScriptsAndALoopbackShowsTheOutputsOneCycleLater)
     } else {
       EXPECT_EQ(bitsDiffering(a, b), d.digitalInputs) << a << " / " << b;
     }
-    // 50 ms half periods: SOEM's loop sleeps 1 ms, and exchanging takes its share too.
-    const std::vector<int> runs = innerRuns(values);
-    EXPECT_GE(runs.size(), 4u);
-    for (const int r : runs) {
-      EXPECT_GE(r, 25);
-      EXPECT_LE(r, 55);
+    // 50 ms half periods, on SOEM's clock: the simulator's time is the host's monotonic clock.
+    const std::vector<std::size_t> at = edges(values);
+    EXPECT_GE(at.size(), 6u) << "400 cycles of at least 1 ms hold 7 edges of a 50 ms square";
+    for (std::size_t e = 1; e < at.size(); ++e) {
+      const long long off = outside(image, at[e - 1], at[e], kHalfPeriodUs);
+      worst = std::max(worst, off);
+      EXPECT_LE(off, kSlackUs) << "edges in cycles " << at[e - 1] << " and " << at[e] << ": "
+                               << image.received[at[e]] - image.received[at[e - 1]]
+                               << " us apart by their answers";
     }
   }
+  std::printf("%s: the edges of the inputs' squares lay at most %lld us outside their cycles\n",
+              GetParam(), worst);
 
   const int loopDo = static_cast<int>(devices) + 1;
   const int loopDi = loopDo + 1;
