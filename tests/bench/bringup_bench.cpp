@@ -8,6 +8,9 @@
 //   sim_share   the part of cpu_s spent in the simulator (Segment + NetworkServer)
 //   frames, datagrams   what the master sent; virtual_ms: the bring-up on the bus clock
 //   kb_per_slave        resident memory after bring-up minus before the network, per slave
+//   wire_digest         FNV-1a over every frame the master sent, in order: on virtual time the
+//                       bring-up is deterministic, so a change meant to leave the master's
+//                       frames alone must leave this figure alone
 // Figures, not a pass/fail test. Run: build/default/tests/bench/bringup_bench [N...]
 #include <fmt/core.h>
 #include <sys/wait.h>
@@ -39,6 +42,25 @@ std::int64_t cpuNs(clockid_t id) {
 double wallS() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
+
+// Passes frames through, folding every frame sent into an FNV-1a digest.
+class DigestLink final : public Link {
+ public:
+  explicit DigestLink(Link& inner) : inner_(inner) {}
+  Status send(ConstBytes frame) override {
+    for (std::uint8_t b : frame) digest_ = (digest_ ^ b) * 0x100000001B3ull;
+    return inner_.send(frame);
+  }
+  Result<std::size_t> receive(Bytes buffer, std::chrono::nanoseconds timeout) override {
+    return inner_.receive(buffer, timeout);
+  }
+  std::string describe() const override { return inner_.describe(); }
+  std::uint64_t digest() const { return digest_; }
+
+ private:
+  Link& inner_;
+  std::uint64_t digest_{0xCBF29CE484222325ull};
+};
 
 // Resident set size now (kB), from /proc/self/status.
 long rssKb() {
@@ -80,7 +102,8 @@ int runOne(unsigned n) {
     }
     return std::nullopt;
   });
-  master::Master m(links.first, bus);
+  DigestLink wire(links.first);
+  master::Master m(wire, bus);
   const double t1 = wallS();
   const auto cpu0 = cpuNs(CLOCK_PROCESS_CPUTIME_ID);
   const SimTime v0 = clock.now();
@@ -93,11 +116,12 @@ int runOne(unsigned n) {
     return 1;
   }
   const auto& counters = m.transport().counters();
-  fmt::print("{:>6} {:>9.3f} {:>10.3f} {:>8.3f} {:>9.2f} {:>8} {:>10} {:>11.1f} {:>13.1f}  {}\n",
+  fmt::print("{:>6} {:>9.3f} {:>10.3f} {:>8.3f} {:>9.2f} {:>8} {:>10} {:>11.1f} {:>13.1f} {:016x}  {}\n",
              n, t1 - t0, t2 - t1, static_cast<double>(cpu) * 1e-9,
              static_cast<double>(simNs) / static_cast<double>(cpu), counters.framesSent,
              counters.datagramsSent, static_cast<double>(clock.now() - v0) / kNsPerMs,
-             static_cast<double>(rss1 - rss0) / n, m.slaves().back().state() == AlState::kOp
+             static_cast<double>(rss1 - rss0) / n, wire.digest(),
+             m.slaves().back().state() == AlState::kOp
                                                        ? "OP"
                                                        : "not OP");
   return 0;
@@ -110,9 +134,9 @@ int main(int argc, char** argv) {
   std::vector<unsigned> sizes;
   for (int i = 1; i < argc; ++i) sizes.push_back(static_cast<unsigned>(std::strtoul(argv[i], nullptr, 0)));
   if (sizes.empty()) sizes = {1000, 4000, 16000, 65535};
-  fmt::print("{:>6} {:>9} {:>10} {:>8} {:>9} {:>8} {:>10} {:>11} {:>13}\n", "slaves", "build_s",
-             "bringup_s", "cpu_s", "sim_share", "frames", "datagrams", "virtual_ms",
-             "kb_per_slave");
+  fmt::print("{:>6} {:>9} {:>10} {:>8} {:>9} {:>8} {:>10} {:>11} {:>13} {:>16}\n", "slaves",
+             "build_s", "bringup_s", "cpu_s", "sim_share", "frames", "datagrams", "virtual_ms",
+             "kb_per_slave", "wire_digest");
   std::fflush(stdout);
   int failed = 0;
   for (unsigned n : sizes) {
