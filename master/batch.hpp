@@ -1,6 +1,11 @@
 // A group of datagrams sent together (the transport packs them into as few frames as fit) and
 // checked together: the register writes of one configuration step, the AL status reads of all
 // slaves. Datagrams live in a deque so their addresses stay fixed while queued.
+//
+// pending() is asked on every pass of a task's loop, and a batch of all slaves' datagrams is
+// answered a few frames at a time: it remembers the first datagram still pending instead of
+// looking at the answered ones again (which made a bring-up quadratic in the number of
+// slaves). A datagram once answered is queued again only through queueAll().
 #pragma once
 
 #include <cstddef>
@@ -16,21 +21,28 @@ namespace ecsim::master {
 
 class DatagramBatch {
  public:
-  Datagram& add() { return datagrams_.emplace_back(); }
-  void clear() { datagrams_.clear(); }
+  Datagram& add() {
+    firstPending_ = 0;
+    return datagrams_.emplace_back();
+  }
+  void clear() {
+    datagrams_.clear();
+    firstPending_ = 0;
+  }
   std::size_t size() const { return datagrams_.size(); }
   bool empty() const { return datagrams_.empty(); }
   Datagram& operator[](std::size_t i) { return datagrams_[i]; }
   const Datagram& operator[](std::size_t i) const { return datagrams_[i]; }
 
   void queueAll(Transport& transport) {
+    firstPending_ = 0;
     for (auto& d : datagrams_) transport.queue(d);
   }
   bool pending() const {
-    for (const auto& d : datagrams_) {
-      if (d.pending()) return true;
+    while (firstPending_ < datagrams_.size() && !datagrams_[firstPending_].pending()) {
+      ++firstPending_;
     }
-    return false;
+    return firstPending_ < datagrams_.size();
   }
   // Ok when every datagram came back with its expected WKC; otherwise the first failure's
   // code and every failure's context (up to a handful), joined by "; ".
@@ -55,6 +67,7 @@ class DatagramBatch {
  private:
   static constexpr std::size_t kMaxListed = 4;
   std::deque<Datagram> datagrams_;
+  mutable std::size_t firstPending_{0};  // every datagram before it is answered or given up
 };
 
 // A task that runs until every datagram of a batch is answered or given up.

@@ -135,8 +135,10 @@ class Datagram {
   SimTime sentAt_{0};
   SimTime receivedAt_{0};
   std::vector<std::uint8_t> data_;
-  // Transport bookkeeping: the owner while queued or sent, the intrusive queue link.
+  // Transport bookkeeping: the owner while queued or sent, the intrusive queue links (both
+  // ways, so that withdrawing a queued datagram does not walk the queue).
   Transport* owner_{nullptr};
+  Datagram* prev_{nullptr};
   Datagram* next_{nullptr};
 };
 

@@ -99,6 +99,8 @@ ScanTask::ScanTask(Transport& transport, std::vector<SlaveInfo>& slaves, ScanOpt
 void ScanTask::start(SimTime /*now*/) {
   slaves_.clear();
   readers_.clear();
+  awaiting_.clear();
+  timers_ = {};
   batch_.clear();
   status_ = okStatus();
   advice_.reset();
@@ -114,12 +116,8 @@ bool ScanTask::fail(Status status) {
 }
 
 std::optional<SimTime> ScanTask::wakeAt() const {
-  std::optional<SimTime> earliest;
-  for (const auto& r : readers_) {
-    auto t = r.wakeAt();
-    if (t && (!earliest || *t < *earliest)) earliest = t;
-  }
-  return earliest;
+  if (state_ != State::kSii || timers_.empty()) return std::nullopt;
+  return timers_.top().first;
 }
 
 void ScanTask::adviseTimeout() {
@@ -225,11 +223,52 @@ void ScanTask::takeRegisters() {
 
 void ScanTask::startSii(SimTime now) {
   readers_.clear();
+  awaiting_.clear();
+  timers_ = {};
+  siiRunning_ = slaves_.size();
   for (auto& slave : slaves_) {
     auto& reader =
         readers_.emplace_back(transport_, slave.station, slave.siiReads8Bytes, options_.sii);
     reader.start(now);
+    afterStep(static_cast<std::uint32_t>(slave.position));
   }
+}
+
+// A reader still running waits either for its poll interval or for its datagram.
+void ScanTask::afterStep(std::uint32_t reader) {
+  if (auto t = readers_[reader].wakeAt()) {
+    timers_.emplace(*t, reader);
+  } else {
+    awaiting_.push_back(reader);
+  }
+}
+
+bool ScanTask::stepSii(SimTime now) {
+  ready_.clear();
+  // Datagrams answered (or given up), up to the first one still waiting for room in a frame.
+  while (!awaiting_.empty()) {
+    const std::uint32_t r = awaiting_.front();
+    const DatagramState state = readers_[r].datagram().state();
+    if (state == DatagramState::kQueued) break;
+    awaiting_.pop_front();
+    (state == DatagramState::kSent ? inFlight_ : ready_).push_back(r);
+  }
+  for (auto it = inFlight_.rbegin(); it != inFlight_.rend(); ++it) awaiting_.push_front(*it);
+  inFlight_.clear();
+  while (!timers_.empty() && timers_.top().first <= now) {
+    ready_.push_back(timers_.top().second);
+    timers_.pop();
+  }
+  // In slave order, as a pass over every reader would queue their datagrams.
+  std::sort(ready_.begin(), ready_.end());
+  for (std::uint32_t r : ready_) {
+    if (readers_[r].step(now)) {
+      afterStep(r);
+    } else {
+      --siiRunning_;
+    }
+  }
+  return siiRunning_ > 0;
 }
 
 void ScanTask::finishSii() {
@@ -238,6 +277,8 @@ void ScanTask::finishSii() {
     applySii(slave);
   }
   readers_.clear();
+  awaiting_.clear();
+  timers_ = {};
 }
 
 bool ScanTask::step(SimTime now) {
@@ -307,9 +348,7 @@ bool ScanTask::step(SimTime now) {
       [[fallthrough]];
     }
     case State::kSii: {
-      bool running = false;
-      for (auto& reader : readers_) running = reader.step(now) || running;
-      if (running) return true;
+      if (stepSii(now)) return true;
       for (std::size_t i = 0; i < readers_.size(); ++i) {
         if (!readers_[i].status().ok()) {
           return fail(makeError(readers_[i].status().error().code,

@@ -9,14 +9,21 @@
 //   registers   FPRD per slave: ESC information 0x0000-0x0009, alias 0x0012, DL status
 //               0x0110, AL status and code 0x0130-0x0135, EEPROM control 0x0502
 //   SII         every slave's EEPROM at once (one SiiReader each; their datagrams share
-//               frames), then parsed: identity, name, mailbox, categories
+//               frames), then parsed: identity, name, mailbox, categories. A pass steps only
+//               the readers whose datagram came back or whose poll interval is over, in
+//               slave order (as stepping every reader would, but without looking at the
+//               thousands still waiting: that made the scan quadratic in the slaves)
 //
 // The topology (each slave's parent) follows from the DL status of every slave in processing
 // order: a port counts when its loop is open and it has communication.
 #pragma once
 
+#include <cstdint>
 #include <deque>
+#include <functional>
 #include <optional>
+#include <queue>
+#include <utility>
 #include <vector>
 
 #include "master/batch.hpp"
@@ -70,6 +77,8 @@ class ScanTask final : public Task {
   void queueRegisters();
   void takeRegisters();
   void startSii(SimTime now);
+  bool stepSii(SimTime now);
+  void afterStep(std::uint32_t reader);
   void finishSii();
   bool fail(Status status);
 
@@ -81,6 +90,15 @@ class ScanTask final : public Task {
   Datagram count_;
   DatagramBatch batch_;
   std::deque<SiiReader> readers_;
+  // Readers waiting for their datagram, in the order they queued it (the transport sends in
+  // that order, so those still waiting for room in a frame are at the end).
+  std::deque<std::uint32_t> awaiting_;
+  // Readers waiting for their poll interval, earliest first.
+  using Timer = std::pair<SimTime, std::uint32_t>;
+  std::priority_queue<Timer, std::vector<Timer>, std::greater<>> timers_;
+  std::vector<std::uint32_t> ready_;     // scratch: the readers a pass steps
+  std::vector<std::uint32_t> inFlight_;  // scratch: readers whose frame is on the wire
+  std::size_t siiRunning_{0};
   std::optional<TimeoutAdvice> advice_;
 };
 

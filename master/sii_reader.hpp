@@ -46,6 +46,9 @@ class SiiReader final : public Task {
   void start(SimTime now);
   bool step(SimTime now) override;
   std::optional<SimTime> wakeAt() const override { return wakeAt_; }
+  // The datagram the reader waits for when wakeAt() is empty (a caller stepping many readers
+  // steps only those whose datagram came back or whose time came).
+  const Datagram& datagram() const { return datagram_; }
 
   bool done() const { return state_ == State::kDone || state_ == State::kFailed; }
   const Status& status() const { return status_; }

@@ -66,6 +66,7 @@ Transport::~Transport() {
   for (Datagram* d = queueHead_; d != nullptr;) {
     Datagram* next = d->next_;
     d->owner_ = nullptr;
+    d->prev_ = nullptr;
     d->next_ = nullptr;
     d->state_ = DatagramState::kIdle;
     d = next;
@@ -88,6 +89,7 @@ Transport::~Transport() {
 void Transport::queue(Datagram& datagram) {
   if (datagram.owner_ != nullptr) datagram.owner_->cancel(datagram);
   datagram.owner_ = this;
+  datagram.prev_ = queueTail_;
   datagram.next_ = nullptr;
   datagram.state_ = DatagramState::kQueued;
   datagram.wkc_ = 0;
@@ -100,14 +102,10 @@ void Transport::queue(Datagram& datagram) {
 }
 
 void Transport::unlinkQueued(Datagram& datagram) {
-  Datagram* prev = nullptr;
-  for (Datagram* d = queueHead_; d != nullptr; prev = d, d = d->next_) {
-    if (d != &datagram) continue;
-    (prev == nullptr ? queueHead_ : prev->next_) = d->next_;
-    if (queueTail_ == d) queueTail_ = prev;
-    d->next_ = nullptr;
-    return;
-  }
+  (datagram.prev_ == nullptr ? queueHead_ : datagram.prev_->next_) = datagram.next_;
+  (datagram.next_ == nullptr ? queueTail_ : datagram.next_->prev_) = datagram.prev_;
+  datagram.prev_ = nullptr;
+  datagram.next_ = nullptr;
 }
 
 void Transport::cancel(Datagram& datagram) {
@@ -353,9 +351,7 @@ bool Transport::packFrame(Slot& slot, SimTime now) {
     Datagram& d = *queueHead_;
     if (d.length_ > kMaxDatagramData || d.length_ > kMaxDatagramLength) {
       // Could never fit: refuse rather than truncate.
-      queueHead_ = d.next_;
-      if (queueHead_ == nullptr) queueTail_ = nullptr;
-      d.next_ = nullptr;
+      unlinkQueued(d);
       d.owner_ = nullptr;
       d.state_ = DatagramState::kError;
       ++counters_.datagramsRefused;
@@ -364,9 +360,7 @@ bool Transport::packFrame(Slot& slot, SimTime now) {
     if (builder.remainingDataCapacity() < d.length_) break;
     auto view = builder.add(d.command_, *index, d.address_, d.data());
     if (!view.ok()) break;
-    queueHead_ = d.next_;
-    if (queueHead_ == nullptr) queueTail_ = nullptr;
-    d.next_ = nullptr;
+    unlinkQueued(d);
     d.state_ = DatagramState::kSent;
     d.sentAt_ = now;
     slot.datagrams[slot.datagramCount++] = &d;

@@ -290,6 +290,36 @@ TEST_F(ManualPeerTest, CancelledDatagramIgnoresItsAnswer) {
   EXPECT_TRUE(b.check().ok());
 }
 
+// Withdrawing queued datagrams (head, middle, tail; the queue is linked both ways so a
+// scan of thousands of slaves does not walk it for each) leaves the others in their order,
+// and a datagram queued again goes to the end.
+TEST_F(ManualPeerTest, WithdrawnQueuedDatagramsLeaveTheRestInOrder) {
+  Transport transport(links_.first);
+  std::array<Datagram, 5> d;
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    d[i].prepare(Command::kFprd,
+                 DatagramHeader::physical(static_cast<std::uint16_t>(0x1001 + i),
+                                          reg::kAlStatus.address),
+                 2, 1);
+    transport.queue(d[i]);
+  }
+  transport.cancel(d[0]);
+  transport.cancel(d[2]);
+  transport.cancel(d[4]);
+  transport.queue(d[0]);
+  transport.poll(0);
+  std::array<std::uint8_t, kMaxFrameSize> buffer{};
+  const std::size_t length = take(buffer);
+  auto frame = EtherCatFrame::parse(Bytes(buffer.data(), length));
+  ASSERT_TRUE(frame.ok());
+  std::vector<std::uint16_t> stations;
+  for (auto it = frame->begin(); it != frame->end(); ++it) stations.push_back((*it).adp());
+  EXPECT_EQ(stations, (std::vector<std::uint16_t>{0x1002, 0x1004, 0x1001}));
+  EXPECT_EQ(d[2].state(), DatagramState::kIdle);
+  EXPECT_EQ(d[4].state(), DatagramState::kIdle);
+  EXPECT_EQ(d[3].state(), DatagramState::kSent);
+}
+
 TEST_F(ManualPeerTest, CachedFrameGetsAFreshIndexEachTimeAndIsNeverRetried) {
   Transport transport(links_.first);
   master::CachedFrame cached;
