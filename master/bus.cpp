@@ -59,13 +59,14 @@ void VirtualBus::wait(SimTime deadline) {
 
 Status runTask(Task& task, Transport& transport, Bus& bus, SimTime timeout, std::string_view what) {
   const SimTime start = bus.now();
-  const SimTime deadline = start + timeout;
   for (;;) {
     const SimTime now = bus.now();
     transport.poll(now);
     const bool running = task.step(now);
     transport.flush(now);  // send what the step queued; answers wait for the next poll
     if (!running) return okStatus();
+    const SimTime deadline =
+        start + static_cast<SimTime>(static_cast<double>(timeout) * task.timeoutScale());
     if (now >= deadline) {
       return makeError(ErrorCode::kTimeout, std::string(what) + ": not finished after " +
                                                 std::to_string((now - start) / kNsPerMs) + " ms");

@@ -69,10 +69,13 @@ class Task {
   // When the task wants to run again even if no answer arrives (poll intervals); nullopt:
   // only when one of its datagrams is answered or times out.
   virtual std::optional<SimTime> wakeAt() const { return std::nullopt; }
+  // How many times the caller's timeout the task may take, learned while it runs: the scan
+  // learns from its count how much longer than usual this network's frames take.
+  virtual double timeoutScale() const { return 1.0; }
 };
 
-// Steps `task` and the transport until the task finishes (ok) or `timeout` has passed on the
-// bus clock (kTimeout naming `what`). The task's own outcome is read from the task.
+// Steps `task` and the transport until the task finishes (ok) or `timeout` (times the task's
+// timeoutScale()) has passed on the bus clock (kTimeout naming `what`). The task's own outcome is read from the task.
 Status runTask(Task& task, Transport& transport, Bus& bus, SimTime timeout,
                std::string_view what = "task");
 

@@ -201,6 +201,7 @@ class Master {
   const std::vector<StateRefusal>& lastRefusals() const { return refusals_; }
   const std::vector<ReceivedEmergency>& emergencies() const { return emergencies_; }
   Transport& transport() { return transport_; }
+  const Transport& transport() const { return transport_; }
   Bus& bus() { return bus_; }
   const MasterOptions& options() const { return options_; }
 

@@ -134,7 +134,20 @@ void ScanTask::adviseTimeout() {
     transport_.setTimeout(advice.needed);
     advice.raised = true;
   }
+  const SimTime fullFrame = static_cast<SimTime>(kMaxFrameSize) * kNsPerByte100Mbit;
+  advice.framesFitting = static_cast<std::size_t>((advice.roundTrip + fullFrame - 1) / fullFrame);
+  advice.framesBefore = transport_.options().maxFramesInFlight;
+  if (options_.adaptFramesInFlight && advice.framesFitting > advice.framesBefore) {
+    transport_.allowFramesInFlight(advice.framesFitting);
+    advice.framesRaised = transport_.options().maxFramesInFlight > advice.framesBefore;
+  }
   advice_ = advice;
+}
+
+double ScanTask::timeoutScale() const {
+  if (!advice_) return 1.0;
+  const SimTime usual = TransportOptions{}.timeout;
+  return std::max(1.0, static_cast<double>(advice_->needed) / static_cast<double>(usual));
 }
 
 void ScanTask::queueDefaults() {

@@ -46,6 +46,14 @@ struct ScanOptions {
   // (before the scan's own per-slave frames); ScanTask::timeoutAdvice() says it either way.
   bool adaptTimeout{true};
   double timeoutMargin{2.0};
+  // Likewise the frames in flight: a line whose round trip is T holds T / (a full frame's wire
+  // time) frames at once, and fewer in flight leave it idle for most of each round trip (a
+  // 65,535-slave line, 131 ms, holds over 1,000; SOEM's 16 would make its scan take minutes of
+  // bus time). With adaptFramesInFlight the transport may keep that many (at most 255) in
+  // flight. The scan's own timeout (the caller's, through runTask) grows by the factor the
+  // needed frame timeout exceeds the default one: it is meant for a network whose frames fit
+  // the default.
+  bool adaptFramesInFlight{true};
 };
 
 // What the count told about the frame timeout (ScanOptions::adaptTimeout).
@@ -55,6 +63,9 @@ struct TimeoutAdvice {
   SimTime needed{0};     // timeoutMargin x (roundTrip + a full frame's extra wire time)
   SimTime before{0};     // the transport's timeout when the count came back
   bool raised{false};    // the transport's timeout was set to `needed`
+  std::size_t framesFitting{0};  // full-size frames the line holds during one round trip
+  std::size_t framesBefore{0};   // the transport's frames in flight when the count came back
+  bool framesRaised{false};      // the transport may now keep min(framesFitting, 255) in flight
 };
 
 class ScanTask final : public Task {
@@ -64,6 +75,7 @@ class ScanTask final : public Task {
   void start(SimTime now);
   bool step(SimTime now) override;
   std::optional<SimTime> wakeAt() const override;
+  double timeoutScale() const override;
   const Status& status() const { return status_; }
   // Set once the slaves are counted.
   const std::optional<TimeoutAdvice>& timeoutAdvice() const { return advice_; }

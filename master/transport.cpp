@@ -53,8 +53,7 @@ ConstBytes CachedFrame::rxData(std::size_t k) const {
 Transport::Transport(Link& link, TransportOptions options)
     : link_(link),
       options_(options),
-      // At most 255 frames in flight, so a free index always exists.
-      slots_(std::clamp<std::size_t>(options.maxFramesInFlight, 1, 255)) {
+      slots_(std::clamp<std::size_t>(options.maxFramesInFlight, 1, kMaxFramesInFlight)) {
   ethernet_.destination = kBroadcastMac;
   ethernet_.source = options_.source;
   ethernet_.etherType = kEtherTypeEtherCat;
@@ -136,6 +135,13 @@ void Transport::detachCached(CachedFrame& frame) {
   }
   frame.owner_ = nullptr;
   frame.state_ = DatagramState::kIdle;
+}
+
+void Transport::allowFramesInFlight(std::size_t frames) {
+  frames = std::min<std::size_t>(frames, kMaxFramesInFlight);
+  if (frames <= slots_.size()) return;
+  slots_.resize(frames);  // slots are found by position (indexSlot_), never by address
+  options_.maxFramesInFlight = frames;
 }
 
 std::optional<std::uint8_t> Transport::takeIndex() {

@@ -107,6 +107,8 @@ class Transport {
  public:
   // Most datagrams one frame can hold (empty datagrams of 12 bytes in 1498 bytes).
   static constexpr std::size_t kMaxDatagramsPerFrame = 128;
+  // At most 255 frames in flight, so a free index always exists.
+  static constexpr std::size_t kMaxFramesInFlight = 255;
   // Most data one datagram can carry in an untagged frame.
   static constexpr std::size_t kMaxDatagramData =
       kMaxFrameSize - kEthernetHeaderSize - kEtherCatHeaderSize - kDatagramOverhead;
@@ -146,6 +148,9 @@ class Transport {
   const TransportOptions& options() const { return options_; }
   // The per-try timeout of frames sent from now on (the scan raises it for a long network).
   void setTimeout(SimTime timeout) { options_.timeout = timeout; }
+  // Raises the number of frames in flight at once to `frames` (at most 255, one index each);
+  // never lowers it. The scan raises it for a long network, whose wire holds more frames.
+  void allowFramesInFlight(std::size_t frames);
   Link& link() { return link_; }
 
  private:

@@ -47,6 +47,7 @@ TEST(ScanTest, RaisesTheFrameTimeoutToWhatTheCountedLineNeeds) {
     std::vector<SlaveInfo> slaves;
     master::ScanOptions options;
     options.adaptTimeout = adapt;
+    options.adaptFramesInFlight = adapt;
     options.readSii = false;
     ScanTask task(transport, slaves, options);
     task.start(net.clock().now());
@@ -61,6 +62,44 @@ TEST(ScanTest, RaisesTheFrameTimeoutToWhatTheCountedLineNeeds) {
     EXPECT_EQ(advice.before, 2 * kNsPerMs);
     EXPECT_EQ(advice.raised, adapt);
     EXPECT_EQ(transport.options().timeout, adapt ? advice.needed : 2 * kNsPerMs);
+    // The round trip of over 2 ms holds 17 full frames (1514 bytes at 80 ns: 121.12 us each),
+    // more than the 16 in flight by default.
+    EXPECT_EQ(advice.framesFitting, static_cast<std::size_t>(
+                                        (advice.roundTrip + 1514 * 80 - 1) / (1514 * 80)));
+    EXPECT_EQ(advice.framesFitting, 17u);
+    EXPECT_EQ(advice.framesBefore, 16u);
+    EXPECT_EQ(advice.framesRaised, adapt);
+    EXPECT_EQ(transport.options().maxFramesInFlight, adapt ? 17u : 16u);
+  }
+}
+
+// The scan's own timeout is meant for a network whose frames fit the default frame timeout:
+// for a longer one it grows by the factor the needed frame timeout exceeds the default (a
+// 65,535-slave line's SII alone takes minutes of bus time with 2 x 131 ms frame timeouts).
+TEST(ScanTest, ItsOwnTimeoutGrowsWithTheFrameTimeoutTheLineNeeds) {
+  for (const std::size_t n : {4u, 1000u}) {
+    SimNetwork net;
+    for (std::uint32_t i = 0; i < n; ++i) {
+      net.segment().addSlave(slavesim::makeGenericSlave("S" + std::to_string(i + 1), i + 1));
+    }
+    net.segment().wireLine();
+    net.start();
+    Transport transport(net.masterLink());
+    std::vector<SlaveInfo> slaves;
+    master::ScanOptions options;
+    options.readSii = false;
+    ScanTask task(transport, slaves, options);
+    EXPECT_EQ(task.timeoutScale(), 1.0);
+    task.start(net.clock().now());
+    ASSERT_TRUE(master::runTask(task, transport, net.bus(), 10 * kNsPerSecond).ok());
+    const auto& advice = *task.timeoutAdvice();
+    if (n == 4) {
+      EXPECT_EQ(task.timeoutScale(), 1.0);
+    } else {
+      EXPECT_DOUBLE_EQ(task.timeoutScale(),
+                       static_cast<double>(advice.needed) / static_cast<double>(2 * kNsPerMs));
+      EXPECT_GT(task.timeoutScale(), 2.0);
+    }
   }
 }
 
@@ -80,6 +119,8 @@ TEST(ScanTest, LeavesTheTimeoutOfAShortLineAlone) {
   EXPECT_FALSE(task.timeoutAdvice()->raised);
   EXPECT_LT(task.timeoutAdvice()->needed, 2 * kNsPerMs);
   EXPECT_EQ(transport.options().timeout, 2 * kNsPerMs);
+  EXPECT_FALSE(task.timeoutAdvice()->framesRaised);
+  EXPECT_EQ(transport.options().maxFramesInFlight, 16u);
 }
 
 TEST(ScanTest, FindsGenericSlavesWithIdentityNamesAndAddresses) {

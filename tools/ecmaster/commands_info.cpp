@@ -38,7 +38,15 @@ void reportTimeout(const master::Master& master, const GlobalOptions& global) {
                "ecmaster: frame timeout raised from {:g} ms to {:.2f} ms: the count frame's round "
                "trip through {} slaves was {:.3f} ms (set --timeout-ms to choose)\n",
                ms(advice->before), ms(advice->needed), advice->slaves, ms(advice->roundTrip));
-  } else if (global.timeoutMs != 0 && advice->needed > advice->before) {
+  }
+  if (advice->framesRaised) {
+    fmt::print(stderr,
+               "ecmaster: frames in flight raised from {} to {}: the line holds {} full-size "
+               "frames during one round trip\n",
+               advice->framesBefore, master.transport().options().maxFramesInFlight,
+               advice->framesFitting);
+  }
+  if (!advice->raised && global.timeoutMs != 0 && advice->needed > advice->before) {
     fmt::print(stderr,
                "ecmaster: warning: --timeout-ms {} is short for this network: the count frame's "
                "round trip through {} slaves was {:.3f} ms; frames may time out, set --timeout-ms "
