@@ -5,9 +5,13 @@
 // pending() is asked on every pass of a task's loop, and a batch of all slaves' datagrams is
 // answered a few frames at a time: it remembers the first datagram still pending instead of
 // looking at the answered ones again (which made a bring-up quadratic in the number of
-// slaves). A datagram once answered is queued again only through queueAll().
+// slaves). A datagram once answered is queued again only through queueAll() or queue(i),
+// which move the memo back; Transport::queue() on a batch's datagram would leave pending()
+// false while it flies (the health monitor did so and took its status reads before their
+// answers came back over a real link).
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <deque>
 #include <string>
@@ -37,6 +41,11 @@ class DatagramBatch {
   void queueAll(Transport& transport) {
     firstPending_ = 0;
     for (auto& d : datagrams_) transport.queue(d);
+  }
+  // Queues datagram i alone (a task sending a part of its batch again).
+  void queue(std::size_t i, Transport& transport) {
+    firstPending_ = std::min(firstPending_, i);
+    transport.queue(datagrams_[i]);
   }
   bool pending() const {
     while (firstPending_ < datagrams_.size() && !datagrams_[firstPending_].pending()) {

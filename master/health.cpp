@@ -167,15 +167,15 @@ void HealthMonitor::queueStatusReads() {
   for (std::size_t i = 0; i < slaves_.size(); ++i) {
     const Watch& w = slaves_[i];
     if (w.recovery) continue;
-    Datagram& read = reads_[readPositions_.size()];
-    read.fprd(slaveInfos_[i].station, reg::kAlStatus, reg::kAlStatusCode);
-    transport_.queue(read);
+    reads_[readPositions_.size()].fprd(slaveInfos_[i].station, reg::kAlStatus,
+                                       reg::kAlStatusCode);
+    reads_.queue(readPositions_.size(), transport_);
     readPositions_.push_back(i);
     if (w.health.condition == SlaveCondition::kLost ||
         w.health.condition == SlaveCondition::kFailed) {
-      Datagram& probe = probes_[probed_.size()];
-      probe.read(Command::kAprd, Datagram::autoIncrement(i), reg::kConfiguredStationAddress);
-      transport_.queue(probe);
+      probes_[probed_.size()].read(Command::kAprd, Datagram::autoIncrement(i),
+                                   reg::kConfiguredStationAddress);
+      probes_.queue(probed_.size(), transport_);
       probed_.push_back(i);
     }
   }

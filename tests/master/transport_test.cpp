@@ -7,6 +7,7 @@
 #include <array>
 #include <deque>
 
+#include "master/batch.hpp"
 #include "master/bus.hpp"
 #include "protocol/registers.hpp"
 #include "slavesim/generic_slave.hpp"
@@ -318,6 +319,29 @@ TEST_F(ManualPeerTest, WithdrawnQueuedDatagramsLeaveTheRestInOrder) {
   EXPECT_EQ(d[2].state(), DatagramState::kIdle);
   EXPECT_EQ(d[4].state(), DatagramState::kIdle);
   EXPECT_EQ(d[3].state(), DatagramState::kSent);
+}
+
+// A batch remembers its first pending datagram; one of its datagrams queued again alone
+// (the health monitor sends its status reads again each interval) is pending again until
+// its answer comes. Here no answer comes: with the memo left behind, pending() said false
+// and the monitor read working counter 0 from every slave over veth.
+TEST_F(ManualPeerTest, BatchDatagramQueuedAgainAloneIsPendingUntilAnswered) {
+  Transport transport(links_.first);
+  master::DatagramBatch batch;
+  for (std::uint16_t i = 0; i < 2; ++i) {
+    batch.add().fprd(static_cast<std::uint16_t>(0x1001 + i), reg::kAlStatus);
+  }
+  batch.queueAll(transport);
+  transport.cancel(batch[0]);
+  transport.cancel(batch[1]);
+  EXPECT_FALSE(batch.pending());
+  batch.queue(0, transport);
+  EXPECT_TRUE(batch.pending());
+  transport.poll(0);
+  std::array<std::uint8_t, kMaxFrameSize> buffer{};
+  EXPECT_GT(take(buffer), 0u);
+  EXPECT_EQ(batch[0].state(), DatagramState::kSent);
+  EXPECT_TRUE(batch.pending());
 }
 
 TEST_F(ManualPeerTest, CachedFrameGetsAFreshIndexEachTimeAndIsNeverRetried) {
