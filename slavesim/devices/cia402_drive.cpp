@@ -254,13 +254,28 @@ void Cia402Drive::measure() {
 }
 
 void Cia402Drive::step(coe::ObjectDictionary& /*od*/, AlState al, SimTime now) {
-  if (syncActive() && started_) return;  // the SYNC0 pulses run the drive
+  if (!syncActive()) pulsed_ = false;
+  if (syncActive() && started_) {
+    // The SYNC0 pulses run the drive. Before the first one the motor still moves on: frozen
+    // from the activation to the start time (100 ms for our master, docs/master.md), six
+    // drives then integrated those 100 ms at the first pulse in one poll, 7 ms of CPU during
+    // which the served network answered no frame.
+    if (!pulsed_) advanceTo(now);
+    return;
+  }
   cycle(al, now);
 }
 
 void Cia402Drive::sync(coe::ObjectDictionary& /*od*/, unsigned signal, AlState al, SimTime now) {
   if (signal != 0 || !syncActive()) return;
+  pulsed_ = true;
   cycle(al, now);
+}
+
+void Cia402Drive::advanceTo(SimTime now) {
+  const SimTime dt = now > lastNow_ ? now - lastNow_ : 0;
+  lastNow_ = std::max(lastNow_, now);
+  advance(dt);
 }
 
 void Cia402Drive::cycle(AlState al, SimTime now) {
@@ -269,9 +284,7 @@ void Cia402Drive::cycle(AlState al, SimTime now) {
     lastNow_ = now;
     readyAt_ = now + params_.initTime;
   }
-  const SimTime dt = now > lastNow_ ? now - lastNow_ : 0;
-  lastNow_ = std::max(lastNow_, now);
-  advance(dt);
+  advanceTo(now);
   if (stateSaver_) (void)stateSaver_->tick(lastNow_, DeviceState{axis_.motor().angle()});
   takeCommands(al);
   publish(now);

@@ -9,7 +9,9 @@
 // from t on, and the inputs show the drive at `now`. While the ESC generates SYNC0
 // (Application::syncActive(), DC synchronous mode) that cycle runs on each SYNC0 pulse instead
 // (sync()), so outputs act and inputs are latched at the pulses, and step() leaves the model
-// alone; without SYNC0 the drive free-runs on step() as described.
+// alone, except that until the first pulse (0x0990 is typically 100 ms after the activation)
+// step() moves the motor on without taking or publishing anything; without SYNC0 the drive
+// free-runs on step() as described.
 //
 // The objects are found by index in whatever dictionary the device has (ecsim's own ESI or a
 // vendor's), moved by DriveParams::axis * 0x800 for the further axes of a multi-axis device.
@@ -21,12 +23,13 @@
 //    communication fault (0x8100): fault reaction, then Fault. Not ready to switch on lasts
 //    DriveParams::initTime after the first step.
 //  - modes (0x6060, shown in 0x6061 once active; a mode 0x6502 does not list is refused and
-//    the previous one stays; a 0x6502 of 0 lists nothing and counts as "all implemented"): CSP (target position interpolated linearly over the 0x60C2
-//    period, its slope as velocity feed-forward), CSV, CST (0x6071 per mille of rated torque),
-//    PP (bit 4 new set-point with acknowledge in bit 12, bit 5 change immediately, bit 6
-//    relative, one buffered set-point, 0x6081/0x6083/0x6084), PV (0x60FF ramped with
-//    0x6083/0x6084), HM (bit 4 starts; methods 37 and 35: the present position is home;
-//    19 and 20: home switch, see DriveParams::homeSwitchCounts). Bit 8 halts PP, PV and HM.
+//    the previous one stays; a 0x6502 of 0 lists nothing and counts as "all implemented"): CSP
+//    (target position interpolated linearly over the 0x60C2 period, its slope as velocity
+//    feed-forward), CSV, CST (0x6071 per mille of rated torque), PP (bit 4 new set-point with
+//    acknowledge in bit 12, bit 5 change immediately, bit 6 relative, one buffered set-point,
+//    0x6081/0x6083/0x6084), PV (0x60FF ramped with 0x6083/0x6084), HM (bit 4 starts; methods 37 and
+//    35: the present position is home; 19 and 20: home switch, see DriveParams::homeSwitchCounts).
+//    Bit 8 halts PP, PV and HM.
 //  - limits: 0x6072 max torque (per mille), 0x6080 max motor speed (rpm, 0: none), 0x607D
 //    software position limits on the unwrapped position (position modes clamp their demand;
 //    velocity and torque modes stop pushing outwards) with bit 11 while one acts; the whole
@@ -198,6 +201,8 @@ class Cia402Drive : public Application {
   void cycle(AlState al, SimTime now);
   void emitEmergency(std::uint16_t code);
   void advance(SimTime dt);
+  // The motor moved on to `now` under the commands it has, nothing taken or published.
+  void advanceTo(SimTime now);
   void substep();
   void measure();
   void takeCommands(AlState al);
@@ -256,6 +261,7 @@ class Cia402Drive : public Application {
   std::uint16_t statusword_{0};
   std::uint16_t errorCode_{0};
   bool started_{false};
+  bool pulsed_{false};  // a SYNC0 pulse came since SYNC0 was last switched on
   SimTime lastNow_{0};
   SimTime pendingNs_{0};
   SimTime clock_{0};  // time of the motor model (the start of the next substep)

@@ -71,6 +71,30 @@ TEST(DriveSync, InputsAreLatchedAtTheSync0PulseAndTheModelAdvancesToIt) {
   EXPECT_NEAR(b.position() - before, 131.072, 15.0) << "one pulse period of motion";
 }
 
+// Between the activation of SYNC0 and its first pulse (0x0990, 100 ms ahead for our master) the
+// drive takes nothing, but its motor keeps turning under the commands it has: a motor does not
+// wait for a pulse. Before, the model stood still for those 100 ms and integrated them all at
+// the first pulse (1,600 substeps per drive in one firmware poll).
+TEST(DriveSync, BeforeTheFirstPulseTheMotorMovesOnAndNothingIsTaken) {
+  dev::DriveParams p = benchParams();
+  DriveBench b(p);
+  b.tick();
+  b.enable();
+  b.mode(9);                                                   // CSV
+  b.set<std::int32_t>(c402::obj::kTargetVelocity, 0, 131072);  // one turn per second
+  b.run(200 * kNsPerMs);                                       // up to speed
+  b.drive->setSyncActive(true);
+  b.set<std::int32_t>(c402::obj::kTargetVelocity, 0, 0);  // not taken before a pulse
+  const double angle = b.drive->axis().motor().angle();
+  const std::int32_t published = b.position();
+  b.run(100 * kNsPerMs);  // firmware steps, no pulse
+  const double turned = (b.drive->axis().motor().angle() - angle) / (2.0 * 3.14159265358979);
+  EXPECT_NEAR(turned, 0.1, 0.01) << "the motor kept its speed for 100 ms";
+  EXPECT_EQ(b.position(), published) << "nothing published before the first pulse";
+  b.drive->sync(*b.od, 0, b.al, b.now);
+  EXPECT_NEAR(b.position() - published, 13107, 200) << "the pulse publishes where it is";
+}
+
 // Through the ESC: the master activates the cyclic unit (0x0990 start, 0x09A0 cycle, 0x0981)
 // and from then on the drive takes its outputs only at the SYNC0 pulses the ESC generates.
 TEST(DriveSync, TheEscsSync0PulsesRunTheDrive) {
