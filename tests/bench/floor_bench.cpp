@@ -344,7 +344,7 @@ int run(int argc, char** argv) {
         std::vector<std::string> command;
         std::uint16_t wkc = 1;
         if (who == "floor") {
-          command = {ECSIM_FLOOR_RESPONDER, ns->simulatorInterface(), "--rt"};
+          command = {ECSIM_FLOOR_RESPONDER, ns->simulatorInterface(), "--rt", "--qdisc-bypass"};
         } else {
           const auto& s = *std::find_if(o.serves.begin(), o.serves.end(),
                                         [&](const auto& x) { return x.name == who; });
