@@ -50,6 +50,10 @@ std::string_view toString(MasterEventKind kind) {
       return "recovered";
     case MasterEventKind::kRecoveryFailed:
       return "recovery failed";
+    case MasterEventKind::kRingBroken:
+      return "ring broken";
+    case MasterEventKind::kRingWhole:
+      return "ring whole";
   }
   return "?";
 }
@@ -85,8 +89,7 @@ HealthMonitor::HealthMonitor(Transport& transport, std::vector<SlaveInfo>& slave
   // The status reads and probes are made once, so that queueing them never allocates.
   for (std::size_t i = 0; i < slaves.size(); ++i) {
     reads_.add().fprd(slaves[i].station, reg::kAlStatus, reg::kAlStatusCode);
-    probes_.add().read(Command::kAprd, Datagram::autoIncrement(i),
-                       reg::kConfiguredStationAddress);
+    probes_.add().read(Command::kAprd, Datagram::autoIncrement(i), reg::kConfiguredStationAddress);
   }
   readPositions_.reserve(slaves.size());
   probed_.reserve(slaves.size());
@@ -112,7 +115,28 @@ void HealthMonitor::markRecovered(std::size_t position, std::uint64_t cycle, Sim
   event(MasterEventKind::kSlaveRecovered, position, cycle, now, "back in OP");
 }
 
+void HealthMonitor::watchRing(std::uint64_t cycle, SimTime now) {
+  const RingState ring = transport_.ring();
+  if (ring == ringSeen_ || slaveInfos_.empty()) return;
+  const RingState before = ringSeen_;
+  ringSeen_ = ring;
+  const std::string at = " at cycle " + std::to_string(cycle);
+  if (ring == RingState::kBroken) {
+    const std::size_t behind =
+        std::min<std::size_t>(transport_.slavesBehindBreak(), slaveInfos_.size() - 1);
+    const std::size_t last = slaveInfos_.size() - 1 - behind;
+    events_.push_back({MasterEventKind::kRingBroken, cycle, now, last,
+                       "ring broken" + at + ": frames come back at the primary port; the break " +
+                           "lies behind " + slaveInfos_[last].label() + ", " +
+                           std::to_string(behind) + " slave(s) answer at the second port"});
+  } else if (ring == RingState::kWhole && before == RingState::kBroken) {
+    events_.push_back({MasterEventKind::kRingWhole, cycle, now, slaveInfos_.size() - 1,
+                       "ring whole again" + at + ": frames come round to the second port"});
+  }
+}
+
 void HealthMonitor::afterCycle(const CycleResult& result, std::uint64_t cycle, SimTime now) {
+  watchRing(cycle, now);
   if (!recovery_) return;
   if (!result.ok()) suspicious_ = true;
   if (readsOut_ && !reads_.pending()) {
@@ -167,8 +191,7 @@ void HealthMonitor::queueStatusReads() {
   for (std::size_t i = 0; i < slaves_.size(); ++i) {
     const Watch& w = slaves_[i];
     if (w.recovery) continue;
-    reads_[readPositions_.size()].fprd(slaveInfos_[i].station, reg::kAlStatus,
-                                       reg::kAlStatusCode);
+    reads_[readPositions_.size()].fprd(slaveInfos_[i].station, reg::kAlStatus, reg::kAlStatusCode);
     reads_.queue(readPositions_.size(), transport_);
     readPositions_.push_back(i);
     if (w.health.condition == SlaveCondition::kLost ||
@@ -320,6 +343,8 @@ MasterHealth HealthMonitor::health(const TransportCounters& transport) const {
   h.cyclesWithErrors = st.cyclesWithErrors;
   h.slavesLost = slavesLost_;
   h.slavesRecovered = slavesRecovered_;
+  h.ring = transport_.ring();
+  h.ringBreaks = transport.ringBreaks;
   h.slaves.reserve(slaves_.size());
   for (const auto& w : slaves_) h.slaves.push_back(w.health);
   return h;

@@ -80,6 +80,10 @@ struct MasterHealth {
   std::uint64_t cyclesWithErrors{0};
   std::uint64_t slavesLost{0};  // events
   std::uint64_t slavesRecovered{0};
+  // Cable redundancy (Transport::setRedundantLink): what the last frame saw, and how often the
+  // ring broke.
+  RingState ring{RingState::kNone};
+  std::uint64_t ringBreaks{0};
   std::vector<SlaveHealth> slaves;
   bool allOperational() const;
 };
@@ -91,6 +95,9 @@ enum class MasterEventKind : std::uint8_t {
   kSlaveError,      // AL error or state below OP
   kSlaveRecovered,  // back in OP
   kRecoveryFailed,
+  kRingBroken,  // redundancy: frames come back at the primary port (position: the last slave
+                // the primary port reaches)
+  kRingWhole,   // redundancy: frames come round to the second port again
 };
 std::string_view toString(MasterEventKind kind);
 
@@ -142,6 +149,8 @@ class HealthMonitor {
   void updateExpectations();
 
   Transport& transport_;
+  RingState ringSeen_{RingState::kNone};
+  void watchRing(std::uint64_t cycle, SimTime now);
   std::vector<SlaveInfo>& slaveInfos_;
   const ProcessImageLayout& layout_;
   CyclicExchange& cyclic_;

@@ -200,6 +200,10 @@ class Master {
   const CycleResult& lastCycle() const { return lastCycle_; }
   const std::vector<StateRefusal>& lastRefusals() const { return refusals_; }
   const std::vector<ReceivedEmergency>& emergencies() const { return emergencies_; }
+  // Cable redundancy: `link` is the master's second port, wired to the far end of the line
+  // (Transport::setRedundantLink; events kRingBroken/kRingWhole). Before start(); it must
+  // outlive the master.
+  void setRedundantLink(Link* link) { transport_.setRedundantLink(link); }
   Transport& transport() { return transport_; }
   const Transport& transport() const { return transport_; }
   Bus& bus() { return bus_; }

@@ -3,13 +3,43 @@
 #include <algorithm>
 #include <cstring>
 
+#include "protocol/registers.hpp"
+
 namespace ecsim::master {
 namespace {
 
 constexpr std::size_t kIndexByte = 1;  // offset of the index within a datagram header
 constexpr std::size_t kMaxReceivesPerPoll = 1024;
 
+// Where the index of the first datagram lies in an untagged frame.
+constexpr std::size_t kFirstIndexAt = kEthernetHeaderSize + kEtherCatHeaderSize + kIndexByte;
+
+// The source address as sent: ESCs set the locally administered bit of the first byte of
+// every frame they pass (ESC datasheet section I §3), so that bit is not compared.
+bool sameSource(ConstBytes frame, const MacAddress& source) {
+  constexpr std::uint8_t kLocalBit = 0x02;
+  constexpr std::size_t kSourceAt = 6;
+  if (frame.size() < kSourceAt + source.size()) return false;
+  for (std::size_t i = 0; i < source.size(); ++i) {
+    const std::uint8_t mask = i == 0 ? static_cast<std::uint8_t>(~kLocalBit) : 0xFF;
+    if ((frame[kSourceAt + i] & mask) != (source[i] & mask)) return false;
+  }
+  return true;
+}
+
 }  // namespace
+
+std::string_view toString(RingState state) {
+  switch (state) {
+    case RingState::kNone:
+      return "none";
+    case RingState::kWhole:
+      return "whole";
+    case RingState::kBroken:
+      return "broken";
+  }
+  return "?";
+}
 
 // ---- CachedFrame ------------------------------------------------------------------------------
 
@@ -191,8 +221,28 @@ Status Transport::send(CachedFrame& frame, SimTime now) {
   frame.sentAt_ = now;
   ++counters_.framesSent;
   counters_.datagramsSent += frame.datagramOffsets_.size();
-  if (auto sent = link_.send(frame.tx()); !sent.ok()) ++counters_.sendErrors;
+  transmit(frame.tx(), *index);
   return okStatus();
+}
+
+void Transport::setRedundantLink(Link* link) {
+  redundant_ = link;
+  if (link == nullptr) return;
+  EthernetHeader ethernet = ethernet_;
+  ethernet.source = options_.secondarySource;
+  FrameBuilder builder(Bytes(brd_.data(), brd_.size()), ethernet);
+  (void)builder.add(Command::kBrd, 0, DatagramHeader::physical(0, reg::kType.address),
+                    reg::kType.width);
+  brdLength_ = builder.finish().valueOr(0);
+}
+
+void Transport::transmit(ConstBytes frame, std::uint8_t index) {
+  if (auto sent = link_.send(frame); !sent.ok()) ++counters_.sendErrors;
+  if (redundant_ == nullptr || brdLength_ == 0) return;
+  brd_[kFirstIndexAt] = index;
+  if (auto sent = redundant_->send(ConstBytes(brd_.data(), brdLength_)); !sent.ok()) {
+    ++counters_.sendErrors;
+  }
 }
 
 void Transport::abandon(CachedFrame& frame) {
@@ -224,6 +274,7 @@ void Transport::release(Slot& slot, DatagramState datagramState) {
     slot.cached = nullptr;
   }
   slot.datagramCount = 0;
+  slot.passedOn = false;
   indexState_[slot.index] =
       datagramState == DatagramState::kTimedOut ? IndexState::kGivenUp : IndexState::kClosed;
   indexSlot_[slot.index] = -1;
@@ -246,16 +297,48 @@ void Transport::poll(SimTime now) {
 }
 
 void Transport::receiveAll(SimTime now) {
+  receiveFrom(link_, Port::kPrimary, now);
+  if (redundant_ != nullptr) receiveFrom(*redundant_, Port::kSecondary, now);
+}
+
+void Transport::receiveFrom(Link& link, Port port, SimTime now) {
   for (std::size_t n = 0; n < kMaxReceivesPerPoll; ++n) {
-    auto received = link_.receive(rx_, std::chrono::nanoseconds(0));
+    auto received = link.receive(rx_, std::chrono::nanoseconds(0));
     if (!received.ok()) {
       ++counters_.receiveErrors;
       continue;
     }
     if (*received == 0) return;
     ++counters_.framesReceived;
-    handleFrame(*received, now);
+    if (port == Port::kSecondary) secondaryDelivers_ = true;
+    handleFrame(*received, now, port);
   }
+}
+
+bool Transport::takeSecondaryBrd(std::size_t length, Port port) {
+  const ConstBytes frame(rx_.data(), length);
+  if (!sameSource(frame, options_.secondarySource)) return false;
+  auto parsed = ConstEtherCatFrame::parse(frame);
+  if (parsed.ok() && parsed->datagramCount() == 1) {
+    slavesBehindBreak_ = port == Port::kSecondary ? (*parsed->begin()).wkc() : 0;
+  }
+  return true;
+}
+
+bool Transport::passOn(Slot& slot, std::size_t length, SimTime now) {
+  if (ring_ == RingState::kWhole) ++counters_.ringBreaks;
+  ring_ = RingState::kBroken;
+  if (!secondaryDelivers_ || slot.passedOn) return false;
+  std::memcpy(slot.cameBack.data(), rx_.data(), length);
+  slot.cameBackLength = length;
+  if (auto sent = redundant_->send(ConstBytes(rx_.data(), length)); !sent.ok()) {
+    ++counters_.sendErrors;
+    return false;
+  }
+  slot.passedOn = true;
+  slot.deadline = now + options_.timeout;
+  ++counters_.framesPassedOn;
+  return true;
 }
 
 bool Transport::answerMatches(const Slot& slot, ConstBytes tx, ConstEtherCatFrame& answer) const {
@@ -278,7 +361,8 @@ bool Transport::answerMatches(const Slot& slot, ConstBytes tx, ConstEtherCatFram
   return true;
 }
 
-void Transport::handleFrame(std::size_t length, SimTime now) {
+void Transport::handleFrame(std::size_t length, SimTime now, Port port) {
+  if (redundant_ != nullptr && takeSecondaryBrd(length, port)) return;
   auto answer = ConstEtherCatFrame::parse(ConstBytes(rx_.data(), length));
   if (!answer.ok() || answer->datagramCount() == 0) {
     ++counters_.framesUnexpected;
@@ -304,12 +388,25 @@ void Transport::handleFrame(std::size_t length, SimTime now) {
     ++counters_.framesUnexpected;
     return;
   }
+  if (redundant_ != nullptr) {
+    if (port == Port::kPrimary && passOn(slot, length, now)) return;
+    if (port == Port::kSecondary && !slot.passedOn) ring_ = RingState::kWhole;
+  }
+  deliver(slot, ConstBytes(rx_.data(), length), now);
+}
+
+void Transport::deliver(Slot& slot, ConstBytes frame, SimTime now) {
   ++counters_.framesAnswered;
   if (slot.cached != nullptr) {
-    CachedFrame& frame = *slot.cached;
-    std::memcpy(frame.rx_.data(), rx_.data(), std::min(length, frame.length_));
-    frame.receivedAt_ = now;
+    CachedFrame& cached = *slot.cached;
+    std::memcpy(cached.rx_.data(), frame.data(), std::min(frame.size(), cached.length_));
+    cached.receivedAt_ = now;
     release(slot, DatagramState::kReceived);
+    return;
+  }
+  auto answer = ConstEtherCatFrame::parse(frame);  // it parsed when it came in
+  if (!answer.ok()) {
+    release(slot, DatagramState::kError);
     return;
   }
   std::size_t k = 0;
@@ -327,11 +424,18 @@ void Transport::handleFrame(std::size_t length, SimTime now) {
 void Transport::checkTimeouts(SimTime now) {
   for (auto& slot : slots_) {
     if (!slot.busy || now < slot.deadline) continue;
+    if (slot.passedOn) {
+      // Nothing came back at the second port: the primary side's answer is all there is.
+      ++counters_.passOnsUnanswered;
+      secondaryDelivers_ = false;
+      deliver(slot, ConstBytes(slot.cameBack.data(), slot.cameBackLength), now);
+      continue;
+    }
     if (slot.triesLeft > 0) {
       --slot.triesLeft;
       slot.deadline = now + options_.timeout;
       ++counters_.framesResent;
-      if (auto sent = link_.send(slotTx(slot)); !sent.ok()) ++counters_.sendErrors;
+      transmit(slotTx(slot), slot.index);
       continue;
     }
     ++counters_.framesLost;
@@ -393,9 +497,7 @@ bool Transport::packFrame(Slot& slot, SimTime now) {
   indexSlot_[*index] = static_cast<std::int16_t>(&slot - slots_.data());
   ++counters_.framesSent;
   counters_.datagramsSent += slot.datagramCount;
-  if (auto sent = link_.send(ConstBytes(slot.buffer.data(), slot.length)); !sent.ok()) {
-    ++counters_.sendErrors;  // retried on timeout like a lost frame
-  }
+  transmit(ConstBytes(slot.buffer.data(), slot.length), *index);  // a send error: retried
   return true;
 }
 

@@ -14,6 +14,24 @@
 //    the network never returned it, late that it came back after we stopped waiting. A frame
 //    that matches nothing of ours (unknown index, other content, not EtherCAT) is unexpected.
 //
+// Cable redundancy (setRedundantLink): the far end of the line is wired back to a second
+// port. Every frame leaves by the primary link, and beside it a 2-byte BRD of the Type register
+// under the same index leaves by the second port, with `secondarySource` as its source address
+// (as SOEM does, ecx_outframe_red). A frame entering at an ESC's port 1 passes it unprocessed
+// (ESC datasheet section I §3.2), so:
+//  - ring whole: our frame comes back at the second port, processed by every slave, and is the
+//    answer; the BRD comes back at the primary port with WKC 0 and is dropped;
+//  - ring broken: our frame comes back at the primary port, processed by the slaves before the
+//    break; it is sent on as it came out of the second port, where the slaves behind the break
+//    process it in their order and it comes back, the answer of the whole ring; the BRD comes
+//    back at the second port, its WKC the number of slaves reachable from that side;
+//  - a frame sent on that is not back by its deadline (nothing behind the second port: its
+//    cable pulled, or the break after the last slave) is answered with what came back at the
+//    primary port, and frames come back unpassed from then on until the second port delivers
+//    a frame again.
+// ring() says which of the two the last frame saw. Not handled: a pulled cable at the primary
+// port (every frame is then lost; SOEM sends it again from the second port).
+//
 // CachedFrame is the cyclic path: a frame built once by its owner, sent as it is each cycle
 // (only its index bytes are rewritten), answered into the frame's own receive buffer. It is
 // never retried: a cyclic frame still unanswered when the next cycle starts is abandoned and
@@ -24,6 +42,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <string_view>
 #include <vector>
 
 #include "link/link.hpp"
@@ -42,7 +61,17 @@ struct TransportOptions {
   std::size_t maxFramesInFlight{16};
   // Source address of our frames: locally administered, unicast.
   MacAddress source{0x02, 0x00, 0x00, 0x00, 0xEC, 0x01};
+  // Source address of the BRD sent beside every frame from the second port (redundancy).
+  MacAddress secondarySource{0x02, 0x00, 0x00, 0x00, 0xEC, 0x02};
 };
+
+// What the frames of a redundant master (Transport::setRedundantLink) saw last.
+enum class RingState : std::uint8_t {
+  kNone,    // no second port, or no frame back yet
+  kWhole,   // the last frame came back at the second port: the ring is closed
+  kBroken,  // the last frame came back at the primary port: the ring is open somewhere
+};
+std::string_view toString(RingState state);
 
 struct TransportCounters {
   std::uint64_t framesSent{0};        // first transmissions (acyclic and cyclic)
@@ -58,6 +87,11 @@ struct TransportCounters {
   std::uint64_t datagramsRefused{0};  // too large for any frame
   std::uint64_t sendErrors{0};
   std::uint64_t receiveErrors{0};
+  // Redundancy: frames back at the primary port sent on from the second port; of those, the
+  // ones not back by their deadline and answered with what came back at the primary port.
+  std::uint64_t framesPassedOn{0};
+  std::uint64_t passOnsUnanswered{0};
+  std::uint64_t ringBreaks{0};  // RingState turned from whole to broken
 };
 
 class Transport;
@@ -153,6 +187,14 @@ class Transport {
   void allowFramesInFlight(std::size_t frames);
   Link& link() { return link_; }
 
+  // Cable redundancy (see above): `link` is the second port; null: none. Set it before any
+  // frame is sent; it must outlive the transport.
+  void setRedundantLink(Link* link);
+  RingState ring() const { return ring_; }
+  // Slaves that answered the last BRD back at the second port: those behind the break, seen
+  // from that side (0 while the ring is whole).
+  std::uint16_t slavesBehindBreak() const { return slavesBehindBreak_; }
+
  private:
   friend class CachedFrame;
   enum class IndexState : std::uint8_t { kUnused, kInFlight, kClosed, kGivenUp };
@@ -166,10 +208,26 @@ class Transport {
     std::array<Datagram*, kMaxDatagramsPerFrame> datagrams{};
     std::size_t datagramCount{0};
     CachedFrame* cached{nullptr};
+    // Redundancy: the frame came back at the primary port and was sent on; what came back.
+    bool passedOn{false};
+    std::array<std::uint8_t, kMaxFrameSize> cameBack{};
+    std::size_t cameBackLength{0};
   };
+  enum class Port : std::uint8_t { kPrimary, kSecondary };
 
   void receiveAll(SimTime now);
-  void handleFrame(std::size_t length, SimTime now);
+  void receiveFrom(Link& link, Port port, SimTime now);
+  void handleFrame(std::size_t length, SimTime now, Port port);
+  // Redundancy: a frame of ours (not the BRD) back at the primary port. True when it was sent
+  // on from the second port (the answer is still to come).
+  bool passOn(Slot& slot, std::size_t length, SimTime now);
+  // The BRD beside a frame; true when `length` bytes in rx_ are one (taken care of).
+  bool takeSecondaryBrd(std::size_t length, Port port);
+  // Sends a frame (first time or again) out of the primary link, and the BRD beside it.
+  void transmit(ConstBytes frame, std::uint8_t index);
+  // Copies an answer in rx_ (`length` bytes) into the slot's datagrams or cached frame and
+  // frees the slot.
+  void deliver(Slot& slot, ConstBytes answer, SimTime now);
   bool answerMatches(const Slot& slot, ConstBytes tx, ConstEtherCatFrame& answer) const;
   void checkTimeouts(SimTime now);
   void sendQueued(SimTime now);
@@ -193,6 +251,12 @@ class Transport {
   Datagram* queueHead_{nullptr};
   Datagram* queueTail_{nullptr};
   std::array<std::uint8_t, kMaxFrameSize> rx_{};
+  Link* redundant_{nullptr};
+  std::array<std::uint8_t, kMaxFrameSize> brd_{};  // the BRD sent from the second port
+  std::size_t brdLength_{0};
+  bool secondaryDelivers_{false};  // a frame came in by the second port since the last miss
+  RingState ring_{RingState::kNone};
+  std::uint16_t slavesBehindBreak_{0};
 };
 
 }  // namespace ecsim::master

@@ -46,13 +46,18 @@ std::string_view conditionOf(master::MasterEventKind kind) {
       return "slave-recovered";
     case master::MasterEventKind::kRecoveryFailed:
       return "recovery-failed";
+    case master::MasterEventKind::kRingBroken:
+      return "ring-broken";
+    case master::MasterEventKind::kRingWhole:
+      return "ring-whole";
   }
   return "?";
 }
 
 // Conditions that are not an error (any-error does not match them).
 bool isGoodNews(std::string_view condition) {
-  return condition == "slave-returned" || condition == "slave-recovered";
+  return condition == "slave-returned" || condition == "slave-recovered" ||
+         condition == "ring-whole";
 }
 
 bool isPoint(ExpectKind kind) {
@@ -75,7 +80,8 @@ std::vector<std::string> RunLog::lines(SimTime origin) const {
                    [](const auto& a, const auto& b) { return a.at < b.at; });
   std::vector<std::string> out;
   out.reserve(sorted.size());
-  for (const auto& e : sorted) out.push_back(fmt::format("{:>12}  {}", msText(e.at - origin), e.text));
+  for (const auto& e : sorted)
+    out.push_back(fmt::format("{:>12}  {}", msText(e.at - origin), e.text));
   return out;
 }
 
@@ -203,8 +209,9 @@ std::optional<double> Judge::statistic(const Expectation& x) const {
   // How often the master reported a condition (Detected's names), of one slave when the
   // expectation names one.
   static constexpr std::string_view kConditions[] = {
-      "wkc-error",   "frame-lost",  "emergency",       "slave-lost",     "slave-returned",
-      "slave-reset", "slave-state", "slave-recovered", "recovery-failed"};
+      "wkc-error",       "frame-lost",  "emergency",   "slave-lost",
+      "slave-returned",  "slave-reset", "slave-state", "slave-recovered",
+      "recovery-failed", "ring-broken", "ring-whole"};
   if (std::find(std::begin(kConditions), std::end(kConditions), x.name) == std::end(kConditions)) {
     return std::nullopt;
   }
@@ -269,8 +276,8 @@ ExpectationResult Judge::evaluatePoint(const Expectation& x, SimTime since) cons
     std::optional<master::ProcessVariable> var;
     if (!x.variable.empty()) {  // by name (checked when the master reached OP)
       if (auto v = master::findVariable(master_->variables(), x.variable); v.ok()) {
-        var = master::ProcessVariable{v->position, v->output, v->bitOffset, v->bitLength,
-                                      v->index,    v->subindex, {}, v->entry};
+        var = master::ProcessVariable{v->position, v->output,   v->bitOffset, v->bitLength,
+                                      v->index,    v->subindex, {},           v->entry};
       }
     } else if (position) {
       for (const auto& v : master::processVariables(master_->layout())) {
@@ -312,9 +319,9 @@ ExpectationResult Judge::evaluateDetected(const Expectation& x, SimTime since) c
   std::vector<std::string> seen;
   for (const auto& o : observations_) {
     if (o.cycle < x.afterCycle) continue;
-    const bool match = ((x.condition == "any-error" && !isGoodNews(o.condition)) ||
-                        o.condition == x.condition) &&
-                       (x.slave.empty() || o.slaves.count(x.slave) > 0);
+    const bool match =
+        ((x.condition == "any-error" && !isGoodNews(o.condition)) || o.condition == x.condition) &&
+        (x.slave.empty() || o.slaves.count(x.slave) > 0);
     if (match && o.cycle <= last) {
       res.passed = true;
       res.at = o.since;
@@ -398,12 +405,11 @@ ExpectationResult Judge::evaluateCommand(std::size_t i, const RunEnd& end,
                                                        msText(*x.afterTime + x.within))
                                          : std::string();
   if (!tally.first) {
-    res.observed =
-        fmt::format("not found in the {} lines of output{}", output.lineCount(), window);
+    res.observed = fmt::format("not found in the {} lines of output{}", output.lineCount(), window);
   } else {
-    res.observed = fmt::format("{} of {} lines{}, the first at {}: '{}'", tally.found,
-                               output.lineCount(), window, msText(tally.first->at - origin),
-                               tally.first->text);
+    res.observed =
+        fmt::format("{} of {} lines{}, the first at {}: '{}'", tally.found, output.lineCount(),
+                    window, msText(tally.first->at - origin), tally.first->text);
   }
   return res;
 }
@@ -421,9 +427,9 @@ std::vector<ExpectationResult> Judge::finish(const RunEnd& end, const CommandFac
       out.push_back(evaluatePoint(x, since));
     } else {
       out.push_back({x.line, x.describe(), false, since,
-                     !end.zero ? "not reached: the network never had all slaves in OP"
-                               : "not reached: the run ended at " + msText(since) + " (" +
-                                     end.text + ")",
+                     !end.zero
+                         ? "not reached: the network never had all slaves in OP"
+                         : "not reached: the run ended at " + msText(since) + " (" + end.text + ")",
                      x.needsRecovery});
     }
   }

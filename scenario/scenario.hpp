@@ -118,9 +118,9 @@ struct Scenario {
 // What a <Detected condition="..."> may name: the runner's own observations of a cycle and the
 // master's events (master/health.hpp), "any-error" for everything but good news.
 inline constexpr std::string_view kDetectableConditions[] = {
-    "wkc-error",       "frame-lost",      "cycle-error",    "emergency",
-    "slave-state",     "slave-lost",      "slave-returned", "slave-reset",
-    "slave-recovered", "recovery-failed", "any-error"};
+    "wkc-error",   "frame-lost",     "cycle-error", "emergency",       "slave-state",
+    "slave-lost",  "slave-returned", "slave-reset", "slave-recovered", "recovery-failed",
+    "ring-broken", "ring-whole",     "any-error"};
 
 // Reading is strict (docs/scenarios.md, "Strictness"): an unknown element or attribute, an
 // action or expectation after the end of the run is an error naming the file, the line and the
