@@ -3,6 +3,7 @@
 #include <poll.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <ctime>
 #include <string>
@@ -26,10 +27,12 @@ void RealTimeBus::wait(SimTime deadline) {
   const SimTime remaining = deadline - clock_.now();
   if (remaining <= 0) return;
   const int fd = link_.pollFd();
-  if (fd >= 0) {
-    pollfd p{fd, POLLIN, 0};
+  const int secondFd = second_ != nullptr ? second_->pollFd() : -1;
+  if (fd >= 0 && (second_ == nullptr || secondFd >= 0)) {
+    std::array<pollfd, 2> p{pollfd{fd, POLLIN, 0}, pollfd{secondFd, POLLIN, 0}};
     const timespec ts = toTimespec(remaining);
-    (void)::ppoll(&p, 1, &ts, nullptr);  // EINTR: return early, the caller loops
+    // EINTR: return early, the caller loops.
+    (void)::ppoll(p.data(), second_ != nullptr ? 2 : 1, &ts, nullptr);
     return;
   }
   const timespec ts = toTimespec(std::min(remaining, kSleepSlice));

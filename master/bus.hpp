@@ -35,14 +35,17 @@ class Bus {
 
 class RealTimeBus final : public Bus {
  public:
-  // link and clock must outlive the bus.
-  RealTimeBus(Link& link, const Clock& clock) : link_(link), clock_(clock) {}
+  // link, clock and `second` must outlive the bus. `second`: the master's second port (cable
+  // redundancy), whose frames end a wait too; null: none.
+  RealTimeBus(Link& link, const Clock& clock, Link* second = nullptr)
+      : link_(link), clock_(clock), second_(second) {}
   SimTime now() const override { return clock_.now(); }
   void wait(SimTime deadline) override;
 
  private:
   Link& link_;
   const Clock& clock_;
+  Link* second_;
 };
 
 class VirtualBus final : public Bus {
@@ -75,7 +78,8 @@ class Task {
 };
 
 // Steps `task` and the transport until the task finishes (ok) or `timeout` (times the task's
-// timeoutScale()) has passed on the bus clock (kTimeout naming `what`). The task's own outcome is read from the task.
+// timeoutScale()) has passed on the bus clock (kTimeout naming `what`). The task's own outcome is
+// read from the task.
 Status runTask(Task& task, Transport& transport, Bus& bus, SimTime timeout,
                std::string_view what = "task");
 

@@ -1,18 +1,22 @@
 // Issue #20 item 4 acceptance: a cable pulled in the middle of the ring during cyclic exchange
 // at 1 kHz loses no cycle for a redundant master, and the ring is whole again when healed.
-// SOEM v1.4.0 (our red_client.c, ec_init_redundant, built against its libsoem.a) runs the
-// ring example (examples/topologies/ring.xml: the demo network with Drive2's port 1 back to
-// the master's second port) over two veth pairs in a private namespace, `ecsim serve --iface
-// --redundant-iface`. Midway `ecsim ctl link-down cable=drives` cuts AI1 from Drive1; two
-// seconds later link-up heals it. With both ports SOEM's frames reach every slave from one
-// side or the other (ecx_waitinframe_red sends the primary's result again from the second
-// port), so every cycle has the whole working counter. The control run has the first port only
-// (ec_init, no second port served): the same break costs it cycles, so the test could not pass
-// with a break that did nothing.
+// Two redundant masters run the ring example (examples/topologies/ring.xml: the demo network
+// with Drive2's port 1 back to the master's second port) over two veth pairs in a private
+// namespace, `ecsim serve --iface --redundant-iface`:
+//   - SOEM v1.4.0 (our red_client.c, ec_init_redundant, built against its libsoem.a):
+//     ecx_waitinframe_red sends the primary's result again from the second port;
+//   - our own `ecmaster --redundant-iface ... cyclic` (master/transport.hpp), which must also
+//     report the break and the heal as events.
+// Midway `ecsim ctl link-down cable=drives` cuts AI1 from Drive1; two seconds later link-up
+// heals it. With both ports the frames reach every slave from one side or the other, so every
+// cycle has the whole working counter. The control run has the first port only (no second
+// port served): the same break costs it cycles, so the test could not pass with a break that
+// did nothing.
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <filesystem>
+#include <functional>
 #include <regex>
 #include <string>
 #include <thread>
@@ -28,14 +32,60 @@ struct RingRun {
   std::string serve;   // ecsim serve's
   int lost{-1};
   int cycles{-1};
+  int exitCode{-1};  // the master's
 };
 
-// Serves the ring, runs red_client for 5 s of cycles, breaks the drives cable after 1.5 s and
-// heals it 2 s later. `redundant` false: the master and the simulator use the first port only
-// (the ring is open at the second, as with that cable unplugged).
-RingRun runRing(bool redundant) {
+// A redundant master: its command line for the first and second port ("" without one), what
+// it prints once it cycles in OP, and how its lost cycles are read from its output.
+struct RingMaster {
+  std::function<std::vector<std::string>(const std::string&, const std::string&)> argv;
+  std::string cycling;
+  std::function<void(RingRun&)> read;
+};
+
+RingMaster soemClient() {
+  return {[](const std::string& first, const std::string& second) {
+            return std::vector<std::string>{(kSoem / "bin-v1" / "red_client").string(), first,
+                                            second.empty() ? "-" : second, "5"};
+          },
+          "op wkc",
+          [](RingRun& run) {
+            std::smatch m;
+            if (std::regex_search(run.master, m, std::regex("done cycles (\\d+) lost (\\d+)"))) {
+              run.cycles = std::stoi(m[1]);
+              run.lost = std::stoi(m[2]);
+            }
+          }};
+}
+
+// ecmaster cyclic for 6 s, the slaves named after the topology; a lost cycle is a failed one
+// (lost frame or WKC error).
+RingMaster ourMaster() {
+  return {[](const std::string& first, const std::string& second) {
+            std::vector<std::string> argv{
+                kEcmaster, "--iface", first, "--names",
+                std::string(ECSIM_SOURCE_DIR) + "/examples/topologies/ring.xml"};
+            if (!second.empty()) argv.insert(argv.end(), {"--redundant-iface", second});
+            argv.insert(argv.end(), {"cyclic", "--cycle-us", "1000", "--seconds", "6"});
+            return argv;
+          },
+          "] cycles ",
+          [](RingRun& run) {
+            std::smatch m;
+            if (std::regex_search(run.master, m, std::regex("\ncycles (\\d+) at"))) {
+              run.cycles = std::stoi(m[1]);
+            }
+            if (std::regex_search(run.master, m, std::regex("failed cycles (\\d+)"))) {
+              run.lost = std::stoi(m[1]);
+            }
+          }};
+}
+
+// Serves the ring, runs the master, breaks the drives cable 1.5 s after it cycles and heals it
+// 2 s later. `redundant` false: the master and the simulator use the first port only (the ring
+// is open at the second, as with that cable unplugged).
+RingRun runRing(const RingMaster& who, bool redundant) {
   RingRun run;
-  const auto client = kSoem / "bin-v1" / "red_client";
   auto ns = VethNamespace::create();
   EXPECT_TRUE(ns.ok()) << (ns.ok() ? "" : ns.error().message());
   if (!ns.ok()) return run;
@@ -65,13 +115,12 @@ RingRun runRing(bool redundant) {
   if (!server.ok()) return run;
   EXPECT_TRUE(waitForText(serveLog, "ecsim: control socket", *server, std::chrono::seconds(20)))
       << readText(serveLog);
-  auto master =
-      ns->spawn(withRealtimePriority({"timeout", "60", client.string(), ns->masterInterface(),
-                                      redundant ? masterB : "-", "5"}),
-                SpawnOptions{masterLog, masterLog});
+  std::vector<std::string> argv{"timeout", "60"};
+  for (auto& a : who.argv(ns->masterInterface(), redundant ? masterB : "")) argv.push_back(a);
+  auto master = ns->spawn(withRealtimePriority(argv), SpawnOptions{masterLog, masterLog});
   EXPECT_TRUE(master.ok());
   if (!master.ok()) return run;
-  EXPECT_TRUE(waitForText(masterLog, "op wkc", *master, std::chrono::seconds(40)))
+  EXPECT_TRUE(waitForText(masterLog, who.cycling, *master, std::chrono::seconds(40)))
       << readText(masterLog) << "\nserve:\n"
       << readText(serveLog);
   std::this_thread::sleep_for(std::chrono::milliseconds(1500));
@@ -81,17 +130,14 @@ RingRun runRing(bool redundant) {
   const CtlResult up = ctl(socket, {"link-up", "cable=drives"});
   EXPECT_EQ(up.status, 0) << up.out;
   auto code = master->wait(std::chrono::seconds(30));
-  EXPECT_TRUE(code.ok() && *code == 0) << readText(masterLog);
+  EXPECT_TRUE(code.ok()) << readText(masterLog);
+  if (code.ok()) run.exitCode = *code;
   EXPECT_TRUE(server->running()) << "ecsim serve died:\n" << readText(serveLog);
   (void)server->kill(SIGINT);
   (void)server->wait(std::chrono::seconds(5));
   run.master = readText(masterLog);
   run.serve = readText(serveLog);
-  std::smatch m;
-  if (std::regex_search(run.master, m, std::regex("done cycles (\\d+) lost (\\d+)"))) {
-    run.cycles = std::stoi(m[1]);
-    run.lost = std::stoi(m[2]);
-  }
+  who.read(run);
   std::filesystem::remove(masterLog);
   std::filesystem::remove(serveLog);
   return run;
@@ -114,7 +160,8 @@ class SoemRedundancy : public ::testing::Test {
 TEST_F(SoemRedundancy, CablePulledMidRingLosesNoCycleForARedundantMaster) {
   std::string attempts;
   for (int attempt = 1; attempt <= 3; ++attempt) {
-    const RingRun ring = runRing(true);
+    const RingRun ring = runRing(soemClient(), true);
+    EXPECT_EQ(ring.exitCode, 0) << ring.master;
     EXPECT_NE(ring.master.find("slaves 6"), std::string::npos) << ring.master;
     EXPECT_EQ(ring.cycles, 5000) << ring.master;
     if (ring.lost == 0) {
@@ -128,9 +175,48 @@ TEST_F(SoemRedundancy, CablePulledMidRingLosesNoCycleForARedundantMaster) {
 }
 
 TEST_F(SoemRedundancy, TheSameBreakCostsASinglePortMasterCycles) {
-  const RingRun line = runRing(false);
+  const RingRun line = runRing(soemClient(), false);
+  EXPECT_EQ(line.exitCode, 0) << line.master;
   EXPECT_EQ(line.cycles, 5000) << line.master;
   EXPECT_GT(line.lost, 100) << "2 s without Drive1 and Drive2\n" << line.master;
+}
+
+// Our master with its second port: no failed cycle, the break reported with its place (the
+// last slave the primary port reaches: AI1) and the heal. Retried as SOEM's run is.
+TEST(EcmasterRedundancy, CablePulledMidRingLosesNoCycleAndIsReportedWhereAndHealed) {
+  std::string attempts;
+  for (int attempt = 1; attempt <= 3; ++attempt) {
+    const RingRun ring = runRing(ourMaster(), true);
+    EXPECT_NE(ring.master.find("6 slaves in OP"), std::string::npos) << ring.master;
+    EXPECT_NE(ring.master.find("event: ring broken at cycle"), std::string::npos) << ring.master;
+    EXPECT_NE(ring.master.find("the break lies behind slave 3 (0x1004 'AI1')"), std::string::npos)
+        << ring.master;
+    EXPECT_NE(ring.master.find("event: ring whole again at cycle"), std::string::npos)
+        << ring.master;
+    EXPECT_NE(ring.master.find("ring whole, broken 1 time(s)"), std::string::npos) << ring.master;
+    EXPECT_GE(ring.cycles, 5900) << ring.master;
+    EXPECT_NE(ring.master.find("slaves lost 0"), std::string::npos) << ring.master;
+    if (ring.lost == 0) {
+      EXPECT_EQ(ring.exitCode, 0) << ring.master;
+      if (attempt > 1)
+        std::fprintf(stderr, "note: passed on run %d; before:\n%s", attempt, attempts.c_str());
+      return;
+    }
+    attempts += "run " + std::to_string(attempt) + ":\n" + ring.master + "serve:\n" + ring.serve;
+  }
+  ADD_FAILURE() << "cycles lost in each of 3 runs:\n" << attempts;
+}
+
+TEST(EcmasterRedundancy, TheSameBreakCostsOurMasterOnOnePortCycles) {
+  const RingRun line = runRing(ourMaster(), false);
+  EXPECT_GE(line.cycles, 5900) << line.master;
+  // With recovery the two drives are reported lost and then no longer expected: a few failed
+  // cycles, and 2 s without their process data.
+  EXPECT_GT(line.lost, 0) << line.master;
+  EXPECT_NE(line.master.find("slaves lost 2"), std::string::npos) << line.master;
+  EXPECT_NE(line.exitCode, 0) << "ecmaster cyclic fails a run with failed cycles";
+  EXPECT_EQ(line.master.find("event: ring"), std::string::npos) << "no second port, no ring";
+  EXPECT_EQ(line.master.find("\nring "), std::string::npos) << line.master;
 }
 
 }  // namespace

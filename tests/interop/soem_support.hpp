@@ -25,6 +25,7 @@
 namespace ecsim::testing {
 
 inline const std::string kEcsim = std::string(ECSIM_BINARY_DIR) + "/tools/ecsim/ecsim";
+inline const std::string kEcmaster = std::string(ECSIM_BINARY_DIR) + "/tools/ecmaster/ecmaster";
 inline const std::filesystem::path kSoem = ECSIM_SOEM_DIR;
 
 inline std::string readText(const std::string& path) {

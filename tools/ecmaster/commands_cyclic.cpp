@@ -209,6 +209,10 @@ int runCyclic(const GlobalOptions& g, const CyclicOptions& o) {
                      {"slavesLost", r.health.slavesLost},
                      {"slavesRecovered", r.health.slavesRecovered},
                      {"simulated", (*c)->simulated()}};
+    if (r.health.ring != master::RingState::kNone) {
+      j["ring"] = std::string(master::toString(r.health.ring));
+      j["ringBreaks"] = r.health.ringBreaks;
+    }
     if (o.rt) {
       j["realtime"] = realtime;
       j["warnings"] = warnings;
@@ -242,6 +246,10 @@ int runCyclic(const GlobalOptions& g, const CyclicOptions& o) {
     fmt::print("lost frames {}, late frames {}, WKC errors {}, failed cycles {}, overruns {}\n",
                lost, late, st.wkcErrors, r.failedCycles, r.overruns);
     fmt::print("slaves lost {}, recovered {}\n", r.health.slavesLost, r.health.slavesRecovered);
+    if (r.health.ring != master::RingState::kNone) {
+      fmt::print("ring {}, broken {} time(s)\n", master::toString(r.health.ring),
+                 r.health.ringBreaks);
+    }
     if (!vars.empty()) fmt::print("variables:{}\n", variablesText(vars));
     if (!r.firstError.empty()) fmt::print("first error: {}\n", r.firstError);
   }

@@ -17,14 +17,26 @@ Result<std::unique_ptr<Connection>> Connection::open(const ConnectOptions& optio
     return makeError(ErrorCode::kInvalidArgument,
                      "give either --iface IF or --sim TOPOLOGY / --sim-slaves N");
   }
+  if (!options.redundantIface.empty() && sim) {
+    return makeError(ErrorCode::kInvalidArgument,
+                     "--redundant-iface needs --iface (a ring's two ports)");
+  }
   if (!sim) {
     ECSIM_ASSIGN_OR_RETURN(
         RawSocketLink raw,
         RawSocketLink::open(options.iface, RawSocketOptions{options.netns, true}));
     c->link_ = std::make_unique<RawSocketLink>(std::move(raw));
-    c->bus_ = std::make_unique<master::RealTimeBus>(*c->link_, c->realClock_);
+    if (!options.redundantIface.empty()) {
+      ECSIM_ASSIGN_OR_RETURN(
+          RawSocketLink second,
+          RawSocketLink::open(options.redundantIface, RawSocketOptions{options.netns, true}));
+      c->redundant_ = std::make_unique<RawSocketLink>(std::move(second));
+    }
+    c->bus_ = std::make_unique<master::RealTimeBus>(*c->link_, c->realClock_, c->redundant_.get());
     c->master_ = std::make_unique<master::Master>(*c->link_, *c->bus_, masterOptions);
+    c->master_->setRedundantLink(c->redundant_.get());
     c->description_ = c->link_->describe();
+    if (c->redundant_) c->description_ += " + " + c->redundant_->describe();
     return c;
   }
   if (!options.simTopology.empty()) {

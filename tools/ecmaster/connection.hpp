@@ -18,6 +18,7 @@ namespace ecsim::tools::ecmaster {
 
 struct ConnectOptions {
   std::string iface;
+  std::string redundantIface;  // --redundant-iface: the second port of a ring
   std::string netns;
   std::string simTopology;  // --sim FILE
   unsigned simSlaves{0};    // --sim-slaves N
@@ -39,7 +40,8 @@ class Connection {
   Connection() = default;
   std::optional<SimTime> serveOne();
 
-  std::unique_ptr<Link> link_;  // raw socket
+  std::unique_ptr<Link> link_;       // raw socket
+  std::unique_ptr<Link> redundant_;  // raw socket of --redundant-iface
   RealClock realClock_;
   VirtualClock virtualClock_{kNsPerSecond};
   topology::Network network_;

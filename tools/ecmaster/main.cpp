@@ -9,8 +9,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include "tools/ecmaster/commands.hpp"
 #include "tools/common/install_paths.hpp"
+#include "tools/ecmaster/commands.hpp"
 
 int main(int argc, char** argv) {
   using namespace ecsim::tools::ecmaster;
@@ -20,6 +20,9 @@ int main(int argc, char** argv) {
   app.fallthrough();
   GlobalOptions global;
   app.add_option("-i,--iface", global.connect.iface, "Network interface of the EtherCAT bus");
+  app.add_option("--redundant-iface", global.connect.redundantIface,
+                 "Second port of a cable-redundant ring (the line's far end); ring breaks are "
+                 "reported as events");
   app.add_option("--netns", global.connect.netns, "Open the interface in this network namespace");
   app.add_option("--sim", global.connect.simTopology,
                  "Talk to an in-process simulated network built from this topology file");
@@ -44,8 +47,7 @@ int main(int argc, char** argv) {
       {"pdos", addPdosCommand(app, global)},         {"upload", addUploadCommand(app, global)},
       {"download", addDownloadCommand(app, global)}, {"sdos", addSdosCommand(app, global)},
       {"cyclic", addCyclicCommand(app, global)},     {"xml", addXmlCommand(app, global)},
-      {"eoe", addEoeCommand(app, global)},
-      {"foe", addFoeCommand(app, global)},
+      {"eoe", addEoeCommand(app, global)},           {"foe", addFoeCommand(app, global)},
       {"soe", addSoeCommand(app, global)},
   };
   CLI11_PARSE(app, argc, argv);
