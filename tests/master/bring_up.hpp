@@ -10,6 +10,7 @@
 #include "master/batch.hpp"
 #include "master/esc_config.hpp"
 #include "master/health.hpp"
+#include "master/master.hpp"
 #include "master/scan.hpp"
 #include "master/state_change.hpp"
 #include "slavesim/esi_slave.hpp"
@@ -77,6 +78,19 @@ inline std::unique_ptr<slavesim::Slave> makeDemoSlave(std::uint32_t product,
 // The demo network of examples/topologies/demo.xml in a line: Coupler, DI1, DO1, AI1, Drive1
 // and, with `drives` 2, Drive2. Then wired; the caller starts the network. `Net` has
 // segment() (SimNetwork and the tests' served or virtual networks).
+// Runs `n` cycles of 1 ms (Master::cycle(), then the bus waits out the period); returns how
+// many failed.
+template <typename Net>
+std::uint64_t runCycles(master::Master& m, Net& net, std::uint64_t n) {
+  std::uint64_t failed = 0;
+  for (std::uint64_t i = 0; i < n; ++i) {
+    const SimTime next = net.clock().now() + kNsPerMs;
+    if (!m.cycle().ok()) ++failed;
+    while (net.clock().now() < next) net.bus().wait(next);
+  }
+  return failed;
+}
+
 template <typename Net>
 void addDemoSlaves(Net& net, int drives = 2) {
   net.segment().addSlave(makeDemoSlave(0x1100, "Coupler"));

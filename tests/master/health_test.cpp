@@ -140,15 +140,7 @@ class RecoveryTest : public ::testing::Test {
     master_->resetStatistics();
   }
   // Runs `n` cycles of 1 ms; returns how many failed.
-  std::uint64_t run(std::uint64_t n) {
-    std::uint64_t failed = 0;
-    for (std::uint64_t i = 0; i < n; ++i) {
-      const SimTime next = net_.clock().now() + kNsPerMs;
-      if (!master_->cycle().ok()) ++failed;
-      while (net_.clock().now() < next) net_.bus().wait(next);
-    }
-    return failed;
-  }
+  std::uint64_t run(std::uint64_t n) { return runCycles(*master_, net_, n); }
   // Cycles until `done` holds (at most `limit`); the number of cycles it took.
   template <typename F>
   std::uint64_t runUntil(F done, std::uint64_t limit) {

@@ -20,46 +20,6 @@ using master::RingState;
 
 enum : std::size_t { kCoupler, kDi, kDo, kAi, kDrive, kCount };
 
-// SimNetwork with a second pair of links: the master's second port and the ring's far end.
-class RingNetwork {
- public:
-  RingNetwork()
-      : primary_(MemoryLink::makePair(256)),
-        secondary_(MemoryLink::makePair(256)),
-        bus_(clock_, [this](SimTime) { return serveOne(); }) {}
-
-  topology::Segment& segment() { return segment_; }
-  void start() {
-    topology::ServerOptions options;
-    options.idleWait = std::chrono::nanoseconds(0);
-    server_ = std::make_unique<topology::NetworkServer>(primary_.second, segment_, clock_, options);
-    server_->setRedundantLink(&secondary_.second);
-  }
-  Link& masterLink() { return primary_.first; }
-  Link& secondPort() { return secondary_.first; }
-  VirtualClock& clock() { return clock_; }
-  master::Bus& bus() { return bus_; }
-
- private:
-  std::optional<SimTime> serveOne() {
-    if (!server_) return std::nullopt;
-    const bool waiting = primary_.second.pending() + secondary_.second.pending() > 0;
-    const auto before = server_->counters().framesAnswered;
-    EXPECT_TRUE(server_->step().ok());
-    if (waiting && server_->counters().framesAnswered != before) {
-      return server_->counters().lastRoundTrip;
-    }
-    return std::nullopt;
-  }
-
-  VirtualClock clock_;
-  topology::Segment segment_;
-  std::pair<MemoryLink, MemoryLink> primary_;
-  std::pair<MemoryLink, MemoryLink> secondary_;
-  std::unique_ptr<topology::NetworkServer> server_;
-  master::VirtualBus bus_;
-};
-
 class RedundancyTest : public ::testing::Test {
  protected:
   // `redundant`: the line's end wired to the master's second port, which the master uses;
@@ -69,23 +29,14 @@ class RedundancyTest : public ::testing::Test {
     if (redundant) {
       ASSERT_TRUE(net_.segment().setRedundantPort(kDrive, 1).ok());
     }
-    net_.start();
+    net_.start(redundant);
     master_ = std::make_unique<master::Master>(net_.masterLink(), net_.bus());
     if (redundant) master_->setRedundantLink(&net_.secondPort());
     auto status = master_->start();
     ASSERT_TRUE(status.ok()) << status.error().message();
     master_->resetStatistics();
   }
-  // Runs `n` cycles of 1 ms; returns how many failed.
-  std::uint64_t run(std::uint64_t n) {
-    std::uint64_t failed = 0;
-    for (std::uint64_t i = 0; i < n; ++i) {
-      const SimTime next = net_.clock().now() + kNsPerMs;
-      if (!master_->cycle().ok()) ++failed;
-      while (net_.clock().now() < next) net_.bus().wait(next);
-    }
-    return failed;
-  }
+  std::uint64_t run(std::uint64_t n) { return runCycles(*master_, net_, n); }
   void setCable(std::size_t a, std::size_t b, bool up) {
     net_.segment().setLinkUp(a, 1, up);
     net_.segment().setLinkUp(b, 0, up);
@@ -102,7 +53,7 @@ class RedundancyTest : public ::testing::Test {
     return nullptr;
   }
 
-  RingNetwork net_;
+  SimNetwork net_;
   std::unique_ptr<master::Master> master_;
 };
 

@@ -76,14 +76,21 @@ class SimNetwork {
   }
 
   topology::Segment& segment() { return segment_; }
-  // Call after the slaves are added and wired.
-  void start() {
+  // Call after the slaves are added and wired. `secondPort`: cable redundancy, the segment's
+  // redundant port (Segment::setRedundantPort) served on a second pair of links, whose master
+  // end is secondPort().
+  void start(bool secondPort = false) {
     topology::ServerOptions options;
     options.idleWait = std::chrono::nanoseconds(0);
     server_ = std::make_unique<topology::NetworkServer>(links_.second, segment_, clock_, options);
+    if (secondPort) {
+      second_.emplace(MemoryLink::makePair(256));
+      server_->setRedundantLink(&second_->second);
+    }
   }
 
   Link& masterLink() { return fault_; }
+  Link& secondPort() { return second_->first; }
   FaultLink& fault() { return fault_; }
   MemoryLink& simulatorEnd() { return links_.second; }
   VirtualClock& clock() { return clock_; }
@@ -93,7 +100,7 @@ class SimNetwork {
  private:
   std::optional<SimTime> serveOne() {
     if (!server_) return std::nullopt;
-    const bool waiting = links_.second.pending() > 0;
+    const bool waiting = links_.second.pending() + (second_ ? second_->second.pending() : 0) > 0;
     const auto before = server_->counters().framesAnswered;
     EXPECT_TRUE(server_->step().ok());
     if (waiting && server_->counters().framesAnswered != before) {
@@ -106,6 +113,7 @@ class SimNetwork {
   topology::Segment segment_;
   std::pair<MemoryLink, MemoryLink> links_;
   FaultLink fault_;
+  std::optional<std::pair<MemoryLink, MemoryLink>> second_;
   std::unique_ptr<topology::NetworkServer> server_;
   std::unique_ptr<master::VirtualBus> bus_;
 };

@@ -43,13 +43,17 @@ TEST(DriveSync, WithSync0TheDriveRunsOnThePulsesOnly) {
   EXPECT_EQ(b.state(), State::kOperationEnabled);
 }
 
-TEST(DriveSync, InputsAreLatchedAtTheSync0PulseAndTheModelAdvancesToIt) {
-  dev::DriveParams p = benchParams();
-  DriveBench b(p);
+// Enabled in CSV, commanded one turn per second.
+void turnInCsv(DriveBench& b) {
   b.tick();
   b.enable();
-  b.mode(9);                                                   // CSV
-  b.set<std::int32_t>(c402::obj::kTargetVelocity, 0, 131072);  // one turn per second
+  b.mode(9);
+  b.set<std::int32_t>(c402::obj::kTargetVelocity, 0, 131072);
+}
+
+TEST(DriveSync, InputsAreLatchedAtTheSync0PulseAndTheModelAdvancesToIt) {
+  DriveBench b(benchParams());
+  turnInCsv(b);
   b.tick();
   b.drive->setSyncActive(true);
   SimTime pulse = b.now;
@@ -76,13 +80,9 @@ TEST(DriveSync, InputsAreLatchedAtTheSync0PulseAndTheModelAdvancesToIt) {
 // wait for a pulse. Before, the model stood still for those 100 ms and integrated them all at
 // the first pulse (1,600 substeps per drive in one firmware poll).
 TEST(DriveSync, BeforeTheFirstPulseTheMotorMovesOnAndNothingIsTaken) {
-  dev::DriveParams p = benchParams();
-  DriveBench b(p);
-  b.tick();
-  b.enable();
-  b.mode(9);                                                   // CSV
-  b.set<std::int32_t>(c402::obj::kTargetVelocity, 0, 131072);  // one turn per second
-  b.run(200 * kNsPerMs);                                       // up to speed
+  DriveBench b(benchParams());
+  turnInCsv(b);
+  b.run(200 * kNsPerMs);  // up to speed
   b.drive->setSyncActive(true);
   b.set<std::int32_t>(c402::obj::kTargetVelocity, 0, 0);  // not taken before a pulse
   const double angle = b.drive->axis().motor().angle();
