@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "protocol/registers.hpp"
+#include "protocol/source_mac.hpp"
 
 namespace ecsim::master {
 namespace {
@@ -15,14 +16,12 @@ constexpr std::size_t kMaxReceivesPerPoll = 1024;
 constexpr std::size_t kFirstIndexAt = kEthernetHeaderSize + kEtherCatHeaderSize + kIndexByte;
 
 // The source address as sent: ESCs set the locally administered bit of the first byte of
-// every frame they pass (ESC datasheet section I §3), so that bit is not compared.
+// every frame they pass, so that bit is not compared.
 bool sameSource(ConstBytes frame, const MacAddress& source) {
-  constexpr std::uint8_t kLocalBit = 0x02;
-  constexpr std::size_t kSourceAt = 6;
-  if (frame.size() < kSourceAt + source.size()) return false;
+  if (frame.size() < kSourceMacOffset + source.size()) return false;
   for (std::size_t i = 0; i < source.size(); ++i) {
-    const std::uint8_t mask = i == 0 ? static_cast<std::uint8_t>(~kLocalBit) : 0xFF;
-    if ((frame[kSourceAt + i] & mask) != (source[i] & mask)) return false;
+    const std::uint8_t mask = i == 0 ? static_cast<std::uint8_t>(~kLocallyAdministeredBit) : 0xFF;
+    if ((frame[kSourceMacOffset + i] & mask) != (source[i] & mask)) return false;
   }
   return true;
 }

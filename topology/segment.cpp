@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <string>
 
+#include "protocol/source_mac.hpp"
+
 namespace ecsim::topology {
 namespace {
 
@@ -248,7 +250,7 @@ FrameOutcome Segment::processFrame(Bytes frame, SimTime sendTime, MasterPort fro
   }
   ++counters_.framesProcessed;
   counters_.datagramsProcessed += count;
-  frame[6] |= 0x02;  // an ESC sets the locally administered bit of the source MAC (§3)
+  frame[kSourceMacOffset] |= kLocallyAdministeredBit;  // as every ESC does
 
   latched_.clear();
   const SimTime frameTime =
