@@ -2,9 +2,9 @@
 # Builds SOEM with the shared script, then the interop tests' own SOEM clients as separate
 # programs: the ones given before --v1-only against each version's libsoem.a, into
 # OUT/bin-v1/<name> and OUT/bin-v2/<name> (sdo_abort_client.c, SOEM's SDO calls; io_client.c,
-# an IO master printing its process image), the ones after it against v1.4.0 only into
-# OUT/bin-v1/<name> (output_client.c, for `ecsim ctl get`; cia402_client.c, a CiA 402 enable
-# sequence and CSP move; red_client.c, a cable-redundant master). A missing script is a failure
+# an IO master printing its process image; red_client.c, a cable-redundant master), the ones
+# after it against v1.4.0 only into OUT/bin-v1/<name> (output_client.c, for `ecsim ctl get`;
+# cia402_client.c, a CiA 402 enable sequence and CSP move). A missing script is a failure
 # under CI=true only.
 # usage: build_soem.sh SHARED_SCRIPT OUT_DIR CLIENT_SOURCE... [--v1-only V1_CLIENT_SOURCE...]
 set -euo pipefail

@@ -1,6 +1,7 @@
 /* A cable-redundant master for the redundancy interop test (docs/topology.md, "Cable
- * redundancy"): SOEM v1.4.0 opened on two ports with ec_init_redundant (or, for the control
- * run, on the first port only with ec_init) brings the network to OP and exchanges process data
+ * redundancy"): SOEM (v1.4.0, or v2.0.0 with -DSOEM_V2) opened on two ports with
+ * ec_init_redundant (v2: ecx_init_redundant with its own ecx_redportt), or for the control run
+ * on the first port only, brings the network to OP and exchanges process data
  * every millisecond, counting the cycles whose working counter is not the whole network's.
  * SOEM's own red_test has its ec_init_redundant call commented out, hence this client.
  * A separate program: built against SOEM's libsoem.a by the ctest fixture (build_soem.sh),
@@ -17,7 +18,39 @@
 #include <string.h>
 #include <time.h>
 
+#ifdef SOEM_V2
+#include "soem/soem.h"
+static ecx_contextt ctx;
+static ecx_redportt redport;
+#define SLAVECOUNT (ctx.slavecount)
+#define SLAVE(i) (ctx.slavelist[i])
+#define GROUP0 (ctx.grouplist[0])
+#define INIT(ifname) ecx_init(&ctx, ifname)
+#define INIT_REDUNDANT(a, b) ecx_init_redundant(&ctx, &redport, a, b)
+#define CONFIG_INIT() ecx_config_init(&ctx)
+#define CONFIG_MAP(map) ecx_config_map_group(&ctx, map, 0)
+#define STATECHECK(s, st, t) ecx_statecheck(&ctx, s, st, t)
+#define WRITESTATE(s) ecx_writestate(&ctx, s)
+#define READSTATE() ecx_readstate(&ctx)
+#define SEND() ecx_send_processdata(&ctx)
+#define RECEIVE() ecx_receive_processdata(&ctx, EC_TIMEOUTRET)
+#define CLOSE() ecx_close(&ctx)
+#else
 #include "ethercat.h"
+#define SLAVECOUNT (ec_slavecount)
+#define SLAVE(i) (ec_slave[i])
+#define GROUP0 (ec_group[0])
+#define INIT(ifname) ec_init(ifname)
+#define INIT_REDUNDANT(a, b) ec_init_redundant(a, b)
+#define CONFIG_INIT() ec_config_init(FALSE)
+#define CONFIG_MAP(map) ec_config_map(map)
+#define STATECHECK(s, st, t) ec_statecheck(s, st, t)
+#define WRITESTATE(s) ec_writestate(s)
+#define READSTATE() ec_readstate()
+#define SEND() ec_send_processdata()
+#define RECEIVE() ec_receive_processdata(EC_TIMEOUTRET)
+#define CLOSE() ec_close()
+#endif
 
 static char io_map[4096];
 
@@ -41,43 +74,43 @@ int main(int argc, char *argv[])
    }
    const int redundant = strcmp(argv[2], "-") != 0;
    const int seconds = atoi(argv[3]);
-   const int opened = redundant ? ec_init_redundant(argv[1], argv[2]) : ec_init(argv[1]);
+   const int opened = redundant ? INIT_REDUNDANT(argv[1], argv[2]) : INIT(argv[1]);
    if (!opened)
    {
       printf("init on %s failed\n", argv[1]);
       return 3;
    }
-   if (ec_config_init(FALSE) <= 0)
+   if (CONFIG_INIT() <= 0)
    {
       printf("slaves 0\n");
-      ec_close();
+      CLOSE();
       return 3;
    }
-   printf("slaves %d\n", ec_slavecount);
-   ec_config_map(&io_map);
-   ec_statecheck(0, EC_STATE_SAFE_OP, EC_TIMEOUTSTATE * 4);
-   const int expected_wkc = (ec_group[0].outputsWKC * 2) + ec_group[0].inputsWKC;
-   ec_slave[0].state = EC_STATE_OPERATIONAL;
-   ec_send_processdata();
-   ec_receive_processdata(EC_TIMEOUTRET);
-   ec_writestate(0);
-   for (int tries = 200; tries > 0 && ec_slave[0].state != EC_STATE_OPERATIONAL; --tries)
+   printf("slaves %d\n", SLAVECOUNT);
+   CONFIG_MAP(&io_map);
+   STATECHECK(0, EC_STATE_SAFE_OP, EC_TIMEOUTSTATE * 4);
+   const int expected_wkc = (GROUP0.outputsWKC * 2) + GROUP0.inputsWKC;
+   SLAVE(0).state = EC_STATE_OPERATIONAL;
+   SEND();
+   RECEIVE();
+   WRITESTATE(0);
+   for (int tries = 200; tries > 0 && SLAVE(0).state != EC_STATE_OPERATIONAL; --tries)
    {
-      ec_send_processdata();
-      ec_receive_processdata(EC_TIMEOUTRET);
-      ec_statecheck(0, EC_STATE_OPERATIONAL, 50000);
+      SEND();
+      RECEIVE();
+      STATECHECK(0, EC_STATE_OPERATIONAL, 50000);
    }
-   if (ec_slave[0].state != EC_STATE_OPERATIONAL)
+   if (SLAVE(0).state != EC_STATE_OPERATIONAL)
    {
-      ec_readstate();
-      for (int i = 1; i <= ec_slavecount; i++)
+      READSTATE();
+      for (int i = 1; i <= SLAVECOUNT; i++)
       {
-         if (ec_slave[i].state != EC_STATE_OPERATIONAL)
+         if (SLAVE(i).state != EC_STATE_OPERATIONAL)
          {
-            printf("not in OP: slave %d state 0x%02x\n", i, ec_slave[i].state);
+            printf("not in OP: slave %d state 0x%02x\n", i, SLAVE(i).state);
          }
       }
-      ec_close();
+      CLOSE();
       return 4;
    }
    printf("op wkc %d\n", expected_wkc);
@@ -89,8 +122,8 @@ int main(int argc, char *argv[])
    clock_gettime(CLOCK_MONOTONIC, &t);
    for (int c = 0; c < cycles; c++)
    {
-      ec_send_processdata();
-      const int wkc = ec_receive_processdata(EC_TIMEOUTRET);
+      SEND();
+      const int wkc = RECEIVE();
       if (wkc != expected_wkc) lost++;
       if (wkc != last_wkc)
       {
@@ -101,8 +134,8 @@ int main(int argc, char *argv[])
       next_cycle(&t);
    }
    printf("done cycles %d lost %d\n", cycles, lost);
-   ec_slave[0].state = EC_STATE_INIT;
-   ec_writestate(0);
-   ec_close();
+   SLAVE(0).state = EC_STATE_INIT;
+   WRITESTATE(0);
+   CLOSE();
    return 0;
 }

@@ -3,8 +3,9 @@
 // Two redundant masters run the ring example (examples/topologies/ring.xml: the demo network
 // with Drive2's port 1 back to the master's second port) over two veth pairs in a private
 // namespace, `ecsim serve --iface --redundant-iface`:
-//   - SOEM v1.4.0 (our red_client.c, ec_init_redundant, built against its libsoem.a):
-//     ecx_waitinframe_red sends the primary's result again from the second port;
+//   - SOEM v1.4.0 and v2.0.0 (our red_client.c, ec_init_redundant / ecx_init_redundant,
+//     built against each one's libsoem.a): ecx_waitinframe_red sends the primary's result
+//     again from the second port;
 //   - our own `ecmaster --redundant-iface ... cyclic` (master/transport.hpp), which must also
 //     report the break and the heal as events.
 // Midway `ecsim ctl link-down cable=drives` cuts AI1 from Drive1; two seconds later link-up
@@ -43,9 +44,10 @@ struct RingMaster {
   std::function<void(RingRun&)> read;
 };
 
-RingMaster soemClient() {
-  return {[](const std::string& first, const std::string& second) {
-            return std::vector<std::string>{(kSoem / "bin-v1" / "red_client").string(), first,
+// bin: "bin-v1" or "bin-v2", the SOEM version red_client was built against.
+RingMaster soemClient(const std::string& bin) {
+  return {[bin](const std::string& first, const std::string& second) {
+            return std::vector<std::string>{(kSoem / bin / "red_client").string(), first,
                                             second.empty() ? "-" : second, "5"};
           },
           "op wkc",
@@ -163,31 +165,35 @@ void expectARunWithoutLostCycles(const RingMaster& who, Check check) {
   ADD_FAILURE() << "cycles lost in each of 3 runs:\n" << attempts;
 }
 
-class SoemRedundancy : public ::testing::Test {
+// The parameter: the folder of the SOEM version red_client was built against.
+class SoemRedundancy : public ::testing::TestWithParam<std::string> {
  protected:
   void SetUp() override {
     ECSIM_REQUIRE_SOEM();
-    if (!std::filesystem::exists(kSoem / "bin-v1" / "red_client")) {
+    if (!std::filesystem::exists(kSoem / GetParam() / "red_client")) {
       if (ciMode()) FAIL() << "red_client not built (tests/interop/build_soem.sh)";
       GTEST_SKIP() << "red_client not built";
     }
   }
 };
 
-TEST_F(SoemRedundancy, CablePulledMidRingLosesNoCycleForARedundantMaster) {
-  expectARunWithoutLostCycles(soemClient(), [](const RingRun& ring) {
+TEST_P(SoemRedundancy, CablePulledMidRingLosesNoCycleForARedundantMaster) {
+  expectARunWithoutLostCycles(soemClient(GetParam()), [](const RingRun& ring) {
     EXPECT_EQ(ring.exitCode, 0) << ring.master;
     EXPECT_NE(ring.master.find("slaves 6"), std::string::npos) << ring.master;
     EXPECT_EQ(ring.cycles, 5000) << ring.master;
   });
 }
 
-TEST_F(SoemRedundancy, TheSameBreakCostsASinglePortMasterCycles) {
-  const RingRun line = runRing(soemClient(), false);
+TEST_P(SoemRedundancy, TheSameBreakCostsASinglePortMasterCycles) {
+  const RingRun line = runRing(soemClient(GetParam()), false);
   EXPECT_EQ(line.exitCode, 0) << line.master;
   EXPECT_EQ(line.cycles, 5000) << line.master;
   EXPECT_GT(line.lost, 100) << "2 s without Drive1 and Drive2\n" << line.master;
 }
+
+INSTANTIATE_TEST_SUITE_P(Soem, SoemRedundancy, ::testing::Values("bin-v1", "bin-v2"),
+                         [](const auto& param) { return param.param == "bin-v1" ? "V1" : "V2"; });
 
 // Not under AddressSanitizer (g++ defines __SANITIZE_ADDRESS__): there `ecsim serve`'s round
 // trips reach 1.2 ms, a broken ring needs two per cycle (the frame is sent on from the second
