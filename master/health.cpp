@@ -122,8 +122,14 @@ void HealthMonitor::watchRing(std::uint64_t cycle, SimTime now) {
   ringSeen_ = ring;
   const std::string at = " at cycle " + std::to_string(cycle);
   if (ring == RingState::kBroken) {
-    const std::size_t behind =
-        std::min<std::size_t>(transport_.slavesBehindBreak(), slaveInfos_.size() - 1);
+    const std::size_t behind = transport_.slavesBehindBreak();
+    if (behind >= slaveInfos_.size()) {
+      events_.push_back({MasterEventKind::kRingBroken, cycle, now, 0,
+                         "ring broken" + at + ": the primary port reaches no slave; the break " +
+                             "lies between it and " + slaveInfos_[0].label() + ", " +
+                             std::to_string(behind) + " slave(s) answer at the second port"});
+      return;
+    }
     const std::size_t last = slaveInfos_.size() - 1 - behind;
     events_.push_back({MasterEventKind::kRingBroken, cycle, now, last,
                        "ring broken" + at + ": frames come back at the primary port; the break " +

@@ -129,6 +129,10 @@ Status Master::scan() {
   ECSIM_TRY(ran);
   ECSIM_TRY(task.status());
   applySlaveNames();
+  // A redundant ring's BRD counting every slave from the second port: the primary port
+  // reaches none (Transport::setRingSlaveCount).
+  transport_.setRingSlaveCount(
+      static_cast<std::uint16_t>(std::min<std::size_t>(slaves_.size(), UINT16_MAX)));
   return okStatus();
 }
 

@@ -274,6 +274,7 @@ void Transport::release(Slot& slot, DatagramState datagramState) {
   }
   slot.datagramCount = 0;
   slot.passedOn = false;
+  slot.brdAtSecondary = false;
   indexState_[slot.index] =
       datagramState == DatagramState::kTimedOut ? IndexState::kGivenUp : IndexState::kClosed;
   indexSlot_[slot.index] = -1;
@@ -314,19 +315,44 @@ void Transport::receiveFrom(Link& link, Port port, SimTime now) {
   }
 }
 
-bool Transport::takeSecondaryBrd(std::size_t length, Port port) {
+bool Transport::takeSecondaryBrd(std::size_t length, Port port, SimTime now) {
   const ConstBytes frame(rx_.data(), length);
   if (!sameSource(frame, options_.secondarySource)) return false;
   auto parsed = ConstEtherCatFrame::parse(frame);
-  if (parsed.ok() && parsed->datagramCount() == 1) {
-    slavesBehindBreak_ = port == Port::kSecondary ? (*parsed->begin()).wkc() : 0;
+  if (!parsed.ok() || parsed->datagramCount() != 1) return true;
+  const auto brd = *parsed->begin();
+  slavesBehindBreak_ = port == Port::kSecondary ? brd.wkc() : 0;
+  if (port != Port::kSecondary || indexState_[brd.index()] != IndexState::kInFlight) return true;
+  Slot& slot = slots_[static_cast<std::size_t>(indexSlot_[brd.index()])];
+  slot.brdAtSecondary = true;
+  // Every slave of the ring answered from the second port: the primary port reaches none, so
+  // the frame sent there is not coming back.
+  if (ringSlaves_ > 0 && brd.wkc() >= ringSlaves_ && !slot.passedOn) {
+    (void)sendFromSecond(slot, now);
   }
   return true;
 }
 
-bool Transport::passOn(Slot& slot, std::size_t length, SimTime now) {
+void Transport::markBroken() {
   if (ring_ == RingState::kWhole) ++counters_.ringBreaks;
   ring_ = RingState::kBroken;
+}
+
+bool Transport::sendFromSecond(Slot& slot, SimTime now) {
+  markBroken();
+  if (auto sent = redundant_->send(slotTx(slot)); !sent.ok()) {
+    ++counters_.sendErrors;
+    return false;
+  }
+  slot.passedOn = true;
+  slot.cameBackLength = 0;
+  slot.deadline = now + options_.timeout;
+  ++counters_.framesSentFromSecond;
+  return true;
+}
+
+bool Transport::passOn(Slot& slot, std::size_t length, SimTime now) {
+  markBroken();
   if (!secondaryDelivers_ || slot.passedOn) return false;
   std::memcpy(slot.cameBack.data(), rx_.data(), length);
   slot.cameBackLength = length;
@@ -361,7 +387,7 @@ bool Transport::answerMatches(const Slot& slot, ConstBytes tx, ConstEtherCatFram
 }
 
 void Transport::handleFrame(std::size_t length, SimTime now, Port port) {
-  if (redundant_ != nullptr && takeSecondaryBrd(length, port)) return;
+  if (redundant_ != nullptr && takeSecondaryBrd(length, port, now)) return;
   auto answer = ConstEtherCatFrame::parse(ConstBytes(rx_.data(), length));
   if (!answer.ok() || answer->datagramCount() == 0) {
     ++counters_.framesUnexpected;
@@ -388,6 +414,12 @@ void Transport::handleFrame(std::size_t length, SimTime now, Port port) {
     return;
   }
   if (redundant_ != nullptr) {
+    if (port == Port::kPrimary && slot.passedOn && slot.cameBackLength == 0) {
+      // Sent from the second port after its timeout, yet the primary side answered after
+      // all: the answer to come at the second port is the one of the frame as sent.
+      ++counters_.framesLate;
+      return;
+    }
     if (port == Port::kPrimary && passOn(slot, length, now)) return;
     if (port == Port::kSecondary && !slot.passedOn) ring_ = RingState::kWhole;
   }
@@ -423,13 +455,20 @@ void Transport::deliver(Slot& slot, ConstBytes frame, SimTime now) {
 void Transport::checkTimeouts(SimTime now) {
   for (auto& slot : slots_) {
     if (!slot.busy || now < slot.deadline) continue;
-    if (slot.passedOn) {
+    if (slot.passedOn && slot.cameBackLength > 0) {
       // Nothing came back at the second port: the primary side's answer is all there is.
       ++counters_.passOnsUnanswered;
       secondaryDelivers_ = false;
       deliver(slot, ConstBytes(slot.cameBack.data(), slot.cameBackLength), now);
       continue;
     }
+    if (!slot.passedOn && slot.brdAtSecondary && sendFromSecond(slot, now)) {
+      // Nothing back at the primary port, the BRD back at the second: as SOEM's
+      // ecx_waitinframe_red, the frame goes out of the second port (not a retry).
+      continue;
+    }
+    slot.passedOn = false;  // a frame sent from the second port and not back: tried anew
+    slot.brdAtSecondary = false;
     if (slot.triesLeft > 0) {
       --slot.triesLeft;
       slot.deadline = now + options_.timeout;

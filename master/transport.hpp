@@ -28,9 +28,15 @@
 //  - a frame sent on that is not back by its deadline (nothing behind the second port: its
 //    cable pulled, or the break after the last slave) is answered with what came back at the
 //    primary port, and frames come back unpassed from then on until the second port delivers
-//    a frame again.
-// ring() says which of the two the last frame saw. Not handled: a pulled cable at the primary
-// port (every frame is then lost; SOEM sends it again from the second port).
+//    a frame again;
+//  - the primary port's own cable pulled: the frame is lost on the dead link, and the BRD
+//    comes back at the second port having passed every slave (the first slave's port 0 loops
+//    it back, and it is processed on its way out again). The frame itself is then sent from
+//    the second port, as built, and its answer comes back there: at once when the BRD counted
+//    the ring's every slave (setRingSlaveCount: the primary side reaches none), otherwise when
+//    the frame's timeout expires with nothing back at the primary port but its BRD back at the
+//    second (as SOEM's ecx_waitinframe_red resends the frame there).
+// ring() says which of the two the last frame saw.
 //
 // CachedFrame is the cyclic path: a frame built once by its owner, sent as it is each cycle
 // (only its index bytes are rewritten), answered into the frame's own receive buffer. It is
@@ -91,6 +97,8 @@ struct TransportCounters {
   // ones not back by their deadline and answered with what came back at the primary port.
   std::uint64_t framesPassedOn{0};
   std::uint64_t passOnsUnanswered{0};
+  // Frames sent as built from the second port: the primary port reached no slave.
+  std::uint64_t framesSentFromSecond{0};
   std::uint64_t ringBreaks{0};  // RingState turned from whole to broken
 };
 
@@ -192,8 +200,13 @@ class Transport {
   void setRedundantLink(Link* link);
   RingState ring() const { return ring_; }
   // Slaves that answered the last BRD back at the second port: those behind the break, seen
-  // from that side (0 while the ring is whole).
+  // from that side (0 while the ring is whole); every slave of the ring when the primary
+  // port reaches none.
   std::uint16_t slavesBehindBreak() const { return slavesBehindBreak_; }
+  // How many slaves the ring has (the master sets it after its scan; 0: unknown). A BRD back
+  // at the second port counting that many means the primary port reaches no slave, and the
+  // frame goes out of the second port without waiting for its timeout.
+  void setRingSlaveCount(std::uint16_t slaves) { ringSlaves_ = slaves; }
 
  private:
   friend class CachedFrame;
@@ -208,8 +221,10 @@ class Transport {
     std::array<Datagram*, kMaxDatagramsPerFrame> datagrams{};
     std::size_t datagramCount{0};
     CachedFrame* cached{nullptr};
-    // Redundancy: the frame came back at the primary port and was sent on; what came back.
+    // Redundancy: the frame came back at the primary port and was sent on; what came back
+    // (length 0: sent as built from the second port, the primary port reaching no slave).
     bool passedOn{false};
+    bool brdAtSecondary{false};  // its BRD came back at the second port
     std::array<std::uint8_t, kMaxFrameSize> cameBack{};
     std::size_t cameBackLength{0};
   };
@@ -221,8 +236,12 @@ class Transport {
   // Redundancy: a frame of ours (not the BRD) back at the primary port. True when it was sent
   // on from the second port (the answer is still to come).
   bool passOn(Slot& slot, std::size_t length, SimTime now);
+  // Redundancy: sends the slot's frame as built from the second port (the primary port
+  // reaches no slave). True when sent.
+  bool sendFromSecond(Slot& slot, SimTime now);
+  void markBroken();
   // The BRD beside a frame; true when `length` bytes in rx_ are one (taken care of).
-  bool takeSecondaryBrd(std::size_t length, Port port);
+  bool takeSecondaryBrd(std::size_t length, Port port, SimTime now);
   // Sends a frame (first time or again) out of the primary link, and the BRD beside it.
   void transmit(ConstBytes frame, std::uint8_t index);
   // Copies an answer in rx_ (`length` bytes) into the slot's datagrams or cached frame and
@@ -257,6 +276,7 @@ class Transport {
   bool secondaryDelivers_{false};  // a frame came in by the second port since the last miss
   RingState ring_{RingState::kNone};
   std::uint16_t slavesBehindBreak_{0};
+  std::uint16_t ringSlaves_{0};
 };
 
 }  // namespace ecsim::master

@@ -10,6 +10,7 @@
 
 #include "master/health.hpp"
 #include "master/master.hpp"
+#include "protocol/registers.hpp"
 #include "tests/master/bring_up.hpp"
 
 namespace ecsim::testing {
@@ -125,6 +126,60 @@ TEST_F(RedundancyTest, TheLastCablePulledCostsOneFrameTimeoutAndNoCycle) {
   ASSERT_NE(broken, nullptr) << eventLog(master_->events());
   EXPECT_EQ(broken->position, kDrive) << broken->text;
   EXPECT_EQ(count(MasterEventKind::kSlaveLost), 0u) << eventLog(master_->events());
+}
+
+// The master's own cable (primary port to the coupler's port 0) pulled: the primary port
+// reaches no slave, and every frame it sends is lost on the dead link. The BRD beside it comes
+// back at the second port having passed every slave: the coupler's port 0, without link, loops
+// the frame back (ESC datasheet section I §3.2), so it is processed on its way back out. The
+// master sends the frame itself from the second port, as SOEM's ecx_waitinframe_red does when
+// the primary port got nothing and the second port its BRD; knowing the ring's slave count it
+// does so as soon as that BRD shows all of them behind the break, without waiting for the
+// frame's timeout, and no cycle is lost.
+TEST_F(RedundancyTest, TheMastersOwnCablePulledLosesNoCycleAndIsReportedAtThePrimaryPort) {
+  build();
+  ASSERT_EQ(run(200), 0u);
+  net_.segment().setLinkUp(kCoupler, 0, false);
+  EXPECT_EQ(run(1000), 0u) << eventLog(master_->events());
+  const auto& c = master_->transport().counters();
+  EXPECT_GE(c.framesSentFromSecond, 1000u);
+  EXPECT_EQ(c.framesLost, 0u);
+  EXPECT_EQ(master_->health().wkcErrors, 0u);
+  EXPECT_EQ(count(MasterEventKind::kSlaveLost), 0u) << eventLog(master_->events());
+  const auto* broken = find(MasterEventKind::kRingBroken);
+  ASSERT_NE(broken, nullptr) << eventLog(master_->events());
+  EXPECT_EQ(broken->position, kCoupler) << broken->text;
+  EXPECT_NE(broken->text.find("the primary port reaches no slave"), std::string::npos)
+      << broken->text;
+  EXPECT_NE(broken->text.find("5 slave(s) answer at the second port"), std::string::npos)
+      << broken->text;
+
+  net_.segment().setLinkUp(kCoupler, 0, true);
+  EXPECT_EQ(run(200), 0u) << eventLog(master_->events());
+  EXPECT_EQ(master_->transport().ring(), RingState::kWhole);
+  EXPECT_EQ(count(MasterEventKind::kRingWhole), 1u) << eventLog(master_->events());
+}
+
+// Without the ring's slave count (a transport used on its own, or slaves missing so that the
+// BRD counts fewer), the master waits for the frame's timeout first, then sends it from the
+// second port: each frame answered, one timeout late, as SOEM's ecx_waitinframe_red.
+TEST_F(RedundancyTest, WithoutTheSlaveCountTheFrameGoesOutOfTheSecondPortAfterItsTimeout) {
+  build();
+  ASSERT_EQ(run(200), 0u);
+  master_->transport().setRingSlaveCount(0);
+  net_.segment().setLinkUp(kCoupler, 0, false);
+  master::Datagram read;
+  read.read(Command::kBrd, 0, reg::kAlStatus, kCount);
+  master_->transport().queue(read);
+  const SimTime sent = net_.bus().now();
+  while (read.pending()) {
+    master_->transport().poll(net_.bus().now());
+    net_.bus().wait(net_.bus().now() + 10 * kNsPerUs);
+  }
+  EXPECT_EQ(read.state(), master::DatagramState::kReceived);
+  EXPECT_EQ(read.wkc(), kCount);
+  EXPECT_GE(net_.bus().now() - sent, master_->transport().options().timeout);
+  EXPECT_EQ(master_->transport().counters().framesSentFromSecond, 1u);
 }
 
 }  // namespace
