@@ -318,27 +318,37 @@ Result<VethNamespace> VethNamespace::create(const VethOptions& options) {
         name, [&] { return writeProcFile(ipv6Conf + "default/disable_ipv6", "1"); }));
   }
   const std::string mtu = std::to_string(options.mtu);
-  ECSIM_TRY(runIp({"ip", "-n", name, "link", "add", ns.masterInterface_, "mtu", mtu, "type", "veth",
-                   "peer", "name", ns.simulatorInterface_, "mtu", mtu}));
-  if (ipv6) {
-    ECSIM_TRY(runInNetworkNamespace(name, [&]() -> Status {
-      Status first = writeProcFile(ipv6Conf + ns.masterInterface_ + "/disable_ipv6", "1");
-      if (!first.ok()) return first;
-      return writeProcFile(ipv6Conf + ns.simulatorInterface_ + "/disable_ipv6", "1");
-    }));
-  }
+  const auto addPair = [&](const std::string& master, const std::string& simulator) -> Status {
+    ECSIM_TRY(runIp({"ip", "-n", name, "link", "add", master, "mtu", mtu, "type", "veth", "peer",
+                     "name", simulator, "mtu", mtu}));
+    if (ipv6) {
+      ECSIM_TRY(runInNetworkNamespace(name, [&]() -> Status {
+        Status first = writeProcFile(ipv6Conf + master + "/disable_ipv6", "1");
+        if (!first.ok()) return first;
+        return writeProcFile(ipv6Conf + simulator + "/disable_ipv6", "1");
+      }));
+    }
+    ECSIM_TRY(runIp({"ip", "-n", name, "link", "set", master, "up"}));
+    ECSIM_TRY(runIp({"ip", "-n", name, "link", "set", simulator, "up"}));
+    ECSIM_TRY(waitOperational(name, master));
+    return waitOperational(name, simulator);
+  };
   ECSIM_TRY(runIp({"ip", "-n", name, "link", "set", "lo", "up"}));
-  ECSIM_TRY(runIp({"ip", "-n", name, "link", "set", ns.masterInterface_, "up"}));
-  ECSIM_TRY(runIp({"ip", "-n", name, "link", "set", ns.simulatorInterface_, "up"}));
-  ECSIM_TRY(waitOperational(name, ns.masterInterface_));
-  ECSIM_TRY(waitOperational(name, ns.simulatorInterface_));
+  ECSIM_TRY(addPair(ns.masterInterface_, ns.simulatorInterface_));
+  if (options.secondPair) {
+    ns.secondMasterInterface_ = "ecm2-" + suffix;
+    ns.secondSimulatorInterface_ = "ecs2-" + suffix;
+    ECSIM_TRY(addPair(ns.secondMasterInterface_, ns.secondSimulatorInterface_));
+  }
   return ns;
 }
 
 VethNamespace::VethNamespace(VethNamespace&& other) noexcept
     : name_(std::exchange(other.name_, {})),
       masterInterface_(std::exchange(other.masterInterface_, {})),
-      simulatorInterface_(std::exchange(other.simulatorInterface_, {})) {}
+      simulatorInterface_(std::exchange(other.simulatorInterface_, {})),
+      secondMasterInterface_(std::exchange(other.secondMasterInterface_, {})),
+      secondSimulatorInterface_(std::exchange(other.secondSimulatorInterface_, {})) {}
 
 VethNamespace& VethNamespace::operator=(VethNamespace&& other) noexcept {
   if (this != &other) {
@@ -346,6 +356,8 @@ VethNamespace& VethNamespace::operator=(VethNamespace&& other) noexcept {
     name_ = std::exchange(other.name_, {});
     masterInterface_ = std::exchange(other.masterInterface_, {});
     simulatorInterface_ = std::exchange(other.simulatorInterface_, {});
+    secondMasterInterface_ = std::exchange(other.secondMasterInterface_, {});
+    secondSimulatorInterface_ = std::exchange(other.secondSimulatorInterface_, {});
   }
   return *this;
 }
@@ -359,6 +371,9 @@ Status VethNamespace::destroy() {
   // Deleting one end removes the pair at once; namespace clean-up in the kernel is
   // asynchronous, so the pair would otherwise outlive `ip netns del` for a moment.
   (void)runIp({"ip", "-n", name_, "link", "del", masterInterface_});
+  if (!secondMasterInterface_.empty()) {
+    (void)runIp({"ip", "-n", name_, "link", "del", secondMasterInterface_});
+  }
   Status status = runIp({"ip", "netns", "del", name_});
   name_.clear();
   return status;

@@ -82,6 +82,9 @@ Status waitOperational(const std::string& netns, const std::string& interface);
 struct VethOptions {
   int mtu{1500};  // an MTU of 1500 carries the largest EtherCAT frame (1514 bytes)
   bool disableIpv6{true};
+  // A second pair "ecm2-<random>" / "ecs2-<random>" in the same namespace: a redundant
+  // master's second port and the simulator's end of it (cable redundancy).
+  bool secondPair{false};
 };
 
 // A private network namespace "ecsim-<pid>-<random>" holding a veth pair "ecm-<random>"
@@ -101,6 +104,9 @@ class VethNamespace {
   const std::string& name() const { return name_; }
   const std::string& masterInterface() const { return masterInterface_; }
   const std::string& simulatorInterface() const { return simulatorInterface_; }
+  // The second pair (VethOptions::secondPair); empty without.
+  const std::string& secondMasterInterface() const { return secondMasterInterface_; }
+  const std::string& secondSimulatorInterface() const { return secondSimulatorInterface_; }
 
   // Starts a program inside the namespace (`ip netns exec NAME argv...`); the returned pid is
   // the program's own.
@@ -118,6 +124,8 @@ class VethNamespace {
   std::string name_;
   std::string masterInterface_;
   std::string simulatorInterface_;
+  std::string secondMasterInterface_;
+  std::string secondSimulatorInterface_;
 };
 
 }  // namespace ecsim

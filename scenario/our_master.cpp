@@ -2,7 +2,8 @@
 // time over a memory link, or over a veth pair on real time. Both run the same cycle: the
 // cycle's start awaited (the network served meanwhile), the slaves' firmware run, one
 // Master::cycle(), its result and events handed to the judge. They differ in the clock, the
-// link and how time passes while the master waits (the Bus).
+// link and how time passes while the master waits (the Bus). A topology with cable redundancy
+// (<Master redundant=>) gives our master its second port too, wired to the ring's far end.
 #include <fmt/core.h>
 #include <poll.h>
 
@@ -40,8 +41,9 @@ class OurMaster : public MasterUnderTest {
   std::string error() const override { return error_; }
 
  protected:
-  // Brings the master to OP over `link`; time zero is then.
-  Status startMaster(Link& link, master::Bus& bus);
+  // Brings the master to OP over `link` (and `second`, its redundant port, if not null); time
+  // zero is then.
+  Status startMaster(Link& link, master::Bus& bus, Link* second);
   // Lets time pass until `t`, the network served meanwhile; false when interrupted.
   virtual bool waitUntil(SimTime t) = 0;
   // The master goes before the link and bus it uses: the subclasses' destructors call this.
@@ -63,12 +65,13 @@ class OurMaster : public MasterUnderTest {
   std::size_t emergenciesSeen_{0};
 };
 
-Status OurMaster::startMaster(Link& link, master::Bus& bus) {
+Status OurMaster::startMaster(Link& link, master::Bus& bus, Link* second) {
   const Scenario& s = c_.scenario;
   master::MasterOptions mo;
   mo.cycleTime = s.cycleTime;
   mo.recovery = c_.options.recovery;
   master_ = std::make_unique<master::Master>(link, bus, mo);
+  master_->setRedundantLink(second);
   // Its events and messages name the slaves as the topology does ("slave 5 (0x1006 'Drive2')").
   master_->setSlaveNames(topology::slaveNamesInBusOrder(segment_));
   if (auto st = master_->start(); !st.ok()) {
@@ -91,7 +94,8 @@ std::optional<Tick> OurMaster::next() {
   if (clock().now() > nextStart_) {
     // A cycle took longer than its period (a frame waited for until it was given up): the
     // cycles in between had no process data.
-    const auto late = static_cast<std::uint64_t>((clock().now() - nextStart_ + period - 1) / period);
+    const auto late =
+        static_cast<std::uint64_t>((clock().now() - nextStart_ + period - 1) / period);
     tick.skipped = std::min(late, total_ - cycle_);
     cycle_ += tick.skipped;
     nextStart_ += static_cast<SimTime>(late) * period;
@@ -182,8 +186,9 @@ class InProcessMaster final : public OurMaster {
     topology::ServerOptions options;
     options.idleWait = std::chrono::nanoseconds(0);
     server_.emplace(links_.second, segment_, clock_, options);
+    if (segment_.redundant()) server_->setRedundantLink(&secondLinks_.second);
     bus_.emplace(clock_, [this](SimTime) -> std::optional<SimTime> {
-      const bool waiting = links_.second.pending() > 0;
+      const bool waiting = links_.second.pending() > 0 || secondLinks_.second.pending() > 0;
       const auto before = server_->counters().framesAnswered;
       (void)server_->step();
       if (waiting && server_->counters().framesAnswered != before) {
@@ -191,7 +196,7 @@ class InProcessMaster final : public OurMaster {
       }
       return std::nullopt;
     });
-    return startMaster(links_.first, *bus_);
+    return startMaster(links_.first, *bus_, segment_.redundant() ? &secondLinks_.first : nullptr);
   }
 
  private:
@@ -201,7 +206,8 @@ class InProcessMaster final : public OurMaster {
   }
 
   VirtualClock clock_{kNsPerSecond};
-  std::pair<MemoryLink, MemoryLink> links_ = MemoryLink::makePair(256);  // master, network
+  std::pair<MemoryLink, MemoryLink> links_ = MemoryLink::makePair(256);        // master, network
+  std::pair<MemoryLink, MemoryLink> secondLinks_ = MemoryLink::makePair(256);  // redundancy
   std::optional<topology::NetworkServer> server_;
   std::optional<master::VirtualBus> bus_;
 };
@@ -217,17 +223,23 @@ bool readable(int fd) {
 // of the pair serves (one thread: no lock between the master, the network and the timeline).
 class ServingBus final : public master::Bus {
  public:
-  ServingBus(const Clock& clock, topology::NetworkServer& server, Link& masterLink)
-      : clock_(clock), server_(server), masterLink_(masterLink) {}
+  ServingBus(const Clock& clock, topology::NetworkServer& server, Link& masterLink,
+             Link* secondLink)
+      : clock_(clock), server_(server), masterLink_(masterLink), secondLink_(secondLink) {}
   SimTime now() const override { return clock_.now(); }
   void wait(SimTime deadline) override {
-    while (!readable(masterLink_.pollFd()) && clock_.now() < deadline) (void)server_.step();
+    while (!readable(masterLink_.pollFd()) &&
+           (secondLink_ == nullptr || !readable(secondLink_->pollFd())) &&
+           clock_.now() < deadline) {
+      (void)server_.step();
+    }
   }
 
  private:
   const Clock& clock_;
   topology::NetworkServer& server_;
   Link& masterLink_;
+  Link* secondLink_;  // the master's redundant port, if any
 };
 
 class VethMaster final : public OurMaster {
@@ -237,7 +249,9 @@ class VethMaster final : public OurMaster {
   const Clock& clock() const override { return clock_; }
   bool virtualTime() const override { return false; }
   Status start() override {
-    auto ns = VethNamespace::create();
+    VethOptions veth;
+    veth.secondPair = segment_.redundant();  // the master's second port and its peer
+    auto ns = VethNamespace::create(veth);
     if (!ns.ok()) {
       return makeError(ns.error().code,
                        "cannot make the veth pair for our master: " + ns.error().message());
@@ -249,15 +263,27 @@ class VethMaster final : public OurMaster {
     auto ours = RawSocketLink::open(ns_->masterInterface(), RawSocketOptions{ns_->name(), true});
     if (!ours.ok()) return ours.error();
     masterLink_.emplace(std::move(*ours));
+    if (veth.secondPair) {
+      const RawSocketOptions raw{ns_->name(), true};
+      auto simSecond = RawSocketLink::open(ns_->secondSimulatorInterface(), raw);
+      if (!simSecond.ok()) return simSecond.error();
+      secondSimulatorLink_.emplace(std::move(*simSecond));
+      auto oursSecond = RawSocketLink::open(ns_->secondMasterInterface(), raw);
+      if (!oursSecond.ok()) return oursSecond.error();
+      secondMasterLink_.emplace(std::move(*oursSecond));
+    }
     topology::ServerOptions options;
     options.paced = true;
     options.idleWait = kPumpWait;
     server_.emplace(*simulatorLink_, segment_, clock_, options);
-    bus_.emplace(clock_, *server_, *masterLink_);
+    Link* second = secondMasterLink_ ? &*secondMasterLink_ : nullptr;
+    if (second != nullptr) server_->setRedundantLink(&*secondSimulatorLink_);
+    bus_.emplace(clock_, *server_, *masterLink_, second);
     if (c_.options.external.realtime) {
-      if (auto note = scheduling_.enable(); !note.empty()) c_.log.add(clock_.now(), "note: " + note);
+      if (auto note = scheduling_.enable(); !note.empty())
+        c_.log.add(clock_.now(), "note: " + note);
     }
-    return startMaster(*masterLink_, *bus_);
+    return startMaster(*masterLink_, *bus_, second);
   }
 
  private:
@@ -278,6 +304,8 @@ class VethMaster final : public OurMaster {
   std::optional<VethNamespace> ns_;
   std::optional<RawSocketLink> simulatorLink_;
   std::optional<RawSocketLink> masterLink_;
+  std::optional<RawSocketLink> secondSimulatorLink_;  // cable redundancy
+  std::optional<RawSocketLink> secondMasterLink_;
   std::optional<topology::NetworkServer> server_;
   std::optional<ServingBus> bus_;
 };

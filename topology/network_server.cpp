@@ -24,6 +24,13 @@ NetworkServer::NetworkServer(Link& link, Segment& segment, const Clock& clock,
                              ServerOptions options)
     : link_(link), segment_(segment), clock_(clock), options_(options) {}
 
+void NetworkServer::setRedundantLink(Link* link) {
+  redundant_ = link;
+  if (link != nullptr && segment_.redundant()) {
+    segment_.setLinkUp(segment_.redundantSlave(), segment_.redundantPortNumber(), true);
+  }
+}
+
 Status NetworkServer::step() {
   return step(std::function<bool()>());
 }

@@ -57,8 +57,9 @@ class NetworkServer {
 
   // Cable redundancy: the master's second port (Segment::setRedundantPort). Frames from either
   // link enter the network at that master port and go back out of the link at the master port
-  // they leave the network at (on a whole ring, the other one). Not owned; null: none.
-  void setRedundantLink(Link* link) { redundant_ = link; }
+  // they leave the network at (on a whole ring, the other one). The redundant port's link
+  // comes up: a master port is wired to it now. Not owned; null: none.
+  void setRedundantLink(Link* link);
 
   // Waits up to the idle wait for one frame, processes and answers it, runs the firmware.
   Status step();

@@ -184,9 +184,6 @@ int runServe(ServeOptions o) {
                "ecsim serve: warning: the topology's redundant port has no master port "
                "(--redundant-iface): the ring is open there\n");
   }
-  if (redundantLink != nullptr) {  // the master's second port is there: its link comes up
-    segment.setLinkUp(segment.redundantSlave(), segment.redundantPortNumber(), true);
-  }
 
   RealClock clock;
   // Captures are stamped with model time; model time 0 is mapped to the Unix time now.
