@@ -284,6 +284,44 @@ TEST_F(ExternalScenario, EcmasterRecoversFromACableBreakAndFailsWithoutRecovery)
   expectNoNamespaceLeft();
 }
 
+// Issue #20: a firmware update over FoE in BOOT (ETG.1000.6 §5.7; docs/devices.md "Firmware
+// update over FoE") is cut by a cable pull in the middle of the transfer. ecmaster must fail
+// with an error naming FoE and the slave; the module, power-cycled, must still run its old
+// software (0x100A 1.0.0: the partial image, whose header carries the new version, was not
+// installed); a second, whole update must then succeed and be installed at the next power
+// cycle (2.0.0: the module was not bricked). A device that installed partial images fails the
+// "after the interrupted update" expectation (checked by hand: see the scenario's comment).
+TEST_F(ExternalScenario, FirmwareUpdateInterruptedByACablePullKeepsTheOldFirmware) {
+  ECSIM_REQUIRE_NETWORK();
+  auto s = loadScenario(kSource / "scenarios/external/firmware_update_interrupted.xml");
+  ASSERT_TRUE(s.ok()) << s.error().message();
+  ExternalRunOptions external;
+  external.outputDir = dir_;
+  external.environment = [](const std::string& name) -> std::optional<std::string> {
+    if (name == "ECMASTER") return std::string(ECSIM_BINARY_DIR) + "/tools/ecmaster/ecmaster";
+    return std::nullopt;
+  };
+  RunOptions options;
+  options.external = external;
+  auto r = runScenario(*s, options);
+  const std::string report = formatReport(r);
+  std::cout << report;
+  ASSERT_TRUE(r.error.empty()) << r.error;
+  EXPECT_TRUE(r.passed()) << report;
+  EXPECT_NE(report.find("link-down cable=module"), std::string::npos) << report;
+  const std::string output = readText(dir_ / "firmware_update_interrupted.output.txt");
+  // In this order: the failed write, the old version, the good write, the new version.
+  const auto failed = output.find("first update: exit 1");
+  const auto old = output.find("version after the interrupted update: 1.0.0");
+  const auto good = output.find("second update: exit 0");
+  const auto installed = output.find("version after the second update: 2.0.0");
+  ASSERT_NE(installed, std::string::npos) << output;
+  EXPECT_LT(failed, old) << output;
+  EXPECT_LT(old, good) << output;
+  EXPECT_LT(good, installed) << output;
+  expectNoNamespaceLeft();
+}
+
 TEST_F(ExternalScenario, SoemSimpleTestRunsToTheEndInOp) {
   ECSIM_REQUIRE_SOEM();
   auto s = loadScenario(kSource / "scenarios/external/soem_simple_test.xml");

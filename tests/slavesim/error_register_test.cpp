@@ -80,7 +80,7 @@ TEST(ErrorRegisterEsi, EveryCoeDeviceOfTheExamplesDeclaresItOnce) {
       EXPECT_EQ(o->flags.pdoMapping, "T") << d.type;
     }
   }
-  EXPECT_EQ(coeDevices, 3u) << "ECS3102, ECS7201, ECS7211";
+  EXPECT_EQ(coeDevices, 4u) << "ECS3102, ECS7201, ECS7211, ECS6010";
 }
 
 // ---- drives: through frames ---------------------------------------------------------------------
