@@ -14,11 +14,15 @@ namespace ecsim::master {
 
 // The SM channel for an area of the slave's memory with the SII/ESI control byte, activated
 // or not (status and PDI control are the ESC's; a master writes them as 0, as SOEM does).
-SyncManagerBlock syncManagerChannel(std::uint16_t start, std::uint16_t length,
-                                    std::uint8_t control, bool enable);
+SyncManagerBlock syncManagerChannel(std::uint16_t start, std::uint16_t length, std::uint8_t control,
+                                    bool enable);
 
-// SM0 and SM1 of a mailbox slave, from its SII (one 16-byte FPWR, as SOEM writes them).
-// Does nothing for a slave without mailbox.
+// SM0 and SM1 of a mailbox slave, from its SII: both switched off (a 16-byte FPWR of zeros),
+// then configured and enabled (one 16-byte FPWR, as SOEM writes them). An SM's start, length
+// and control take an ECAT write only while it is disabled (ESC datasheet section II
+// 0x0800-0x0805), and a slave back from BOOT still has the bootstrap layout enabled (its
+// firmware deactivates it through the PDI only): SOEM zeroes 0x0800 before configuring, IgH
+// clears the SMs at INIT. Does nothing for a slave without mailbox.
 void addMailboxSetup(DatagramBatch& batch, const SlaveInfo& slave);
 
 }  // namespace ecsim::master

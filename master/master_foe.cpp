@@ -1,7 +1,6 @@
 // BOOT state and FoE of class Master (master.hpp): the bootstrap mailbox from the SII, the
 // state change for one slave, and FoE transfers through master/foe_client.hpp.
 #include <algorithm>
-#include <array>
 
 #include "master/batch.hpp"
 #include "master/esc_config.hpp"
@@ -49,11 +48,8 @@ Status Master::enterBootstrap(std::size_t position) {
   m.inStart = boot.sendOffset;
   m.inSize = boot.sendSize;
   slave->mailbox = m;
-  // An SM's start, length and control are writable only while it is disabled (ESC datasheet
-  // section II 0x0800-0x0805): both off first, then the bootstrap layout.
+  // Both off first, then the bootstrap layout (addMailboxSetup).
   DatagramBatch batch;
-  const std::array<std::uint8_t, 2 * reg::kSmSize> off{};
-  batch.add().fpwr(slave->station, reg::smChannel(0), off);
   addMailboxSetup(batch, *slave);
   batch.queueAll(transport_);
   BatchWait wait(batch);

@@ -76,6 +76,48 @@ TEST(FoeClient, BootWriteReadBackAndErrors) {
   EXPECT_TRUE(m.sdoUpload(0, 0x1018, 1).ok());
 }
 
+// A bootstrap mailbox laid out unlike the standard one (examples/esi/ecsim_foe_module.xml:
+// BOOT 0x1000/512 and 0x1200/512, standard 0x1000/128 and 0x1080/128). Back in INIT the SMs
+// still hold the bootstrap layout, enabled: the slave's firmware only deactivates them through
+// the PDI, and an SM's start, length and control take an ECAT write only while its enable bit
+// is off (ESC datasheet section II 0x0800-0x0805). So the standard mailbox goes in only after
+// the master switches SM0/SM1 off first, as SOEM (ecx_set_slaves_to_default, 0x0800 zeroed)
+// and IgH (fsm_slave_config "clear sync managers") do before configuring them. Also for a
+// master started afresh that leaves the slaves as they are (no reset of the defaults, as
+// `ecmaster upload` after `ecmaster foe write --boot`); otherwise PREOP is refused with 0x0016.
+TEST(FoeClient, AfterBootTheStandardMailboxReplacesTheBootstrapLayout) {
+  auto file =
+      loadEsiFile(std::filesystem::path(ECSIM_SOURCE_DIR) / "examples/esi/ecsim_foe_module.xml");
+  ASSERT_TRUE(file.ok()) << file.error().message();
+  SimNetwork net;
+  auto slave = slavesim::makeSlaveFromEsi(*file, file->devices.at(0), "module");
+  ASSERT_TRUE(slave.ok()) << slave.error().message();
+  net.segment().addSlave(std::move(slave).value());
+  net.segment().wireLine();
+  net.start();
+  {
+    master::Master m(net.masterLink(), net.bus());
+    ASSERT_TRUE(m.scan().ok());
+    ASSERT_TRUE(m.enterBootstrap(0).ok());
+    EXPECT_EQ(m.slaves()[0].mailbox->outSize, 512);
+    ASSERT_TRUE(m.foeWrite(0, "fw.bin", pattern(600)).ok());
+    ASSERT_TRUE(m.leaveBootstrap(0).ok());
+    auto preop = m.bringTo(AlState::kPreOp);
+    ASSERT_TRUE(preop.ok()) << preop.error().message();
+    EXPECT_EQ(net.segment().slave(0).esc().smConfig(0).length, 128);
+    ASSERT_TRUE(m.enterBootstrap(0).ok());
+    ASSERT_TRUE(m.leaveBootstrap(0).ok());
+  }
+  master::MasterOptions options;
+  options.scan.resetToDefaults = false;
+  master::Master again(net.masterLink(), net.bus(), options);
+  ASSERT_TRUE(again.scan().ok());
+  auto preop = again.bringTo(AlState::kPreOp);
+  ASSERT_TRUE(preop.ok()) << preop.error().message();
+  EXPECT_EQ(net.segment().slave(0).state(), AlState::kPreOp);
+  EXPECT_TRUE(again.sdoUpload(0, 0x1018, 1).ok());
+}
+
 TEST(FoeClient, BootNeedsABootstrapMailbox) {
   SimNetwork net;
   auto od = std::make_shared<slavesim::coe::ObjectDictionary>();
