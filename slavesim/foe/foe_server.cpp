@@ -46,7 +46,8 @@ FoeServer::FoeServer(std::shared_ptr<FoeFiles> files, FoeServerOptions options)
 void FoeServer::reset() {
   transfer_ = Transfer::kIdle;
   name_.clear();
-  data_.clear();
+  writing_ = FoeFile();
+  reading_.reset();
   packet_ = 0;
   offset_ = 0;
   lastSent_ = false;
@@ -106,15 +107,15 @@ void FoeServer::onData(const Esc& esc, const FoePacket& p, MailboxReplies& repli
                                   foeBusyValue(static_cast<std::uint16_t>(busyLeft_), 100)));
     return;
   }
-  if (data_.size() + p.data.size() > options_.maxFileSize) {
+  if (writing_.size() + p.data.size() > options_.maxFileSize) {
     return sendError(replies, FoeErrorCode::kDiskFull);
   }
-  data_.insert(data_.end(), p.data.begin(), p.data.end());
+  writing_.append(p.data);
   packet_ = p.value;
   const bool last = p.data.size() < foeDataPerPacket(receiveMailboxSize(esc));
   if (last) {
     ++counters_.filesWritten;
-    files_->store(name_, std::move(data_), writingInBoot_);
+    files_->store(name_, std::move(writing_), writingInBoot_);
     const std::uint32_t n = packet_;
     reset();
     replies.send(encodeFoeMailbox(FoeOpcode::kAck, n));
@@ -127,21 +128,21 @@ void FoeServer::onReadRequest(const Esc& /*esc*/, const FoePacket& p, MailboxRep
   reset();
   if (p.data.empty()) return sendError(replies, FoeErrorCode::kIllegal);
   const std::string name(p.text());
-  const std::vector<std::uint8_t>* file = files_->find(name);
+  std::shared_ptr<const FoeFile> file = files_->share(name);
   if (file == nullptr) return sendError(replies, FoeErrorCode::kNotFound);
   if (p.value != options_.password) return sendError(replies, FoeErrorCode::kNoRights);
   transfer_ = Transfer::kReading;
   name_ = name;
-  data_ = *file;
+  reading_ = std::move(file);
   sendData(replies);
 }
 
 void FoeServer::sendData(MailboxReplies& replies) {
   const std::size_t perPacket = foeDataPerPacket(replies.mailboxSize());
-  const std::size_t n = std::min(perPacket, data_.size() - offset_);
+  packetData_.resize(perPacket);
+  const std::size_t n = reading_->copyOut(offset_, packetData_);
   ++packet_;
-  replies.send(encodeFoeMailbox(FoeOpcode::kData, packet_,
-                                ConstBytes(data_).subspan(offset_, n)));
+  replies.send(encodeFoeMailbox(FoeOpcode::kData, packet_, ConstBytes(packetData_).first(n)));
   offset_ += n;
   lastSent_ = n < perPacket;
 }

@@ -27,8 +27,8 @@
 #include <vector>
 
 #include "protocol/foe.hpp"
-#include "slavesim/foe/foe_files.hpp"
 #include "slavesim/coe/object_dictionary.hpp"
+#include "slavesim/foe/foe_files.hpp"
 #include "slavesim/mailbox_protocol.hpp"
 
 namespace ecsim::slavesim::foe {
@@ -81,10 +81,12 @@ class FoeServer final : public MailboxProtocol {
   FoeServerCounters counters_{};
   Transfer transfer_{Transfer::kIdle};
   std::string name_;
-  std::vector<std::uint8_t> data_;
-  std::uint32_t packet_{0};  // last packet acknowledged (write) or sent (read)
-  std::size_t offset_{0};    // read: bytes sent so far
-  bool lastSent_{false};     // read: the final (short) packet is out
+  FoeFile writing_;                         // write: the bytes taken so far
+  std::shared_ptr<const FoeFile> reading_;  // read: the file being sent
+  std::vector<std::uint8_t> packetData_;    // read: one packet's bytes (kept, not reallocated)
+  std::uint32_t packet_{0};                 // last packet acknowledged (write) or sent (read)
+  std::size_t offset_{0};                   // read: bytes sent so far
+  bool lastSent_{false};                    // read: the final (short) packet is out
   bool writingInBoot_{false};
   unsigned busyLeft_{0};
 };
