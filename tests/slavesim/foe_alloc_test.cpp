@@ -1,6 +1,7 @@
 // A large file over FoE is taken and sent without copying it per packet, proved by the largest
 // heap allocation made while its packets are answered: global operator new and delete are
-// replaced in this test binary only (its own executable, as tests/master/cycle_alloc_test.cpp).
+// replaced in this test binary only (support/allocation_counter.hpp; its own executable, as
+// tests/master/cycle_alloc_test.cpp).
 //
 // Why: the simulator answers each DATA packet inside one mailbox turn of the frame path
 // (ETG.1000.6 §5.7: a device that needs time for its flash answers BUSY, it does not stall the
@@ -11,63 +12,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <atomic>
-#include <cstdlib>
-#include <new>
 
 #include "protocol/foe.hpp"
 #include "slavesim/foe/foe_server.hpp"
+#include "support/allocation_counter.hpp"
 #include "tests/slavesim/coe_test_support.hpp"
-
-namespace {
-std::atomic<bool> gCounting{false};
-std::atomic<std::size_t> gLargest{0};
-
-void count(std::size_t size) {
-  if (!gCounting.load(std::memory_order_relaxed)) return;
-  std::size_t seen = gLargest.load();
-  while (size > seen && !gLargest.compare_exchange_weak(seen, size)) {
-  }
-}
-}  // namespace
-
-void* operator new(std::size_t size) {
-  count(size);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) {
-  return ::operator new(size);
-}
-void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
-  count(size);
-  return std::malloc(size == 0 ? 1 : size);
-}
-void* operator new[](std::size_t size, const std::nothrow_t& tag) noexcept {
-  return ::operator new(size, tag);
-}
-// Every non-aligned form is replaced so that malloc pairs with free (also under ASan).
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p, std::size_t) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, const std::nothrow_t&) noexcept {
-  std::free(p);
-}
-void operator delete[](void* p, const std::nothrow_t&) noexcept {
-  std::free(p);
-}
-#pragma GCC diagnostic pop
 
 namespace ecsim::testing {
 namespace {
@@ -82,7 +31,7 @@ constexpr std::size_t kLargestAllowed = 64 * 1024;
 class Counting {
  public:
   Counting() {
-    gLargest = 0;
+    gLargestAllocation = 0;
     gCounting = true;
   }
   ~Counting() { gCounting = false; }
@@ -128,7 +77,7 @@ TEST(FoeAlloc, ALargeFileIsWrittenAndReadWithoutCopyingItPerPacket) {
       ASSERT_EQ(r.value, packet);
       if (n < perPacket) break;
     }
-    largestWrite = gLargest;
+    largestWrite = gLargestAllocation;
   }
   ASSERT_NE(files->find(name), nullptr);
   EXPECT_EQ(files->find(name)->size(), image.size());
@@ -146,7 +95,7 @@ TEST(FoeAlloc, ALargeFileIsWrittenAndReadWithoutCopyingItPerPacket) {
       if (r.data.size() < perPacket) break;
       r = ask(t, FoeOpcode::kAck, r.value, ConstBytes());
     }
-    largestRead = gLargest;
+    largestRead = gLargestAllocation;
   }
   EXPECT_TRUE(back == image) << "read " << back.size() << " of " << image.size() << " bytes";
   EXPECT_LE(largestRead, kLargestAllowed) << "the read request copied the file";

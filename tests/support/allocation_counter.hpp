@@ -2,7 +2,8 @@
 // form, so that allocation and release always pair malloc with free, also under
 // AddressSanitizer, which reports any mismatch; the aligned forms stay the library's, which
 // pair among themselves). Include it in exactly one file of a test binary of its own: no other
-// test sees the replacement. Set gCounting around the code under test and read gAllocations.
+// test sees the replacement. Set gCounting around the code under test and read gAllocations
+// and gLargestAllocation (the largest size asked for while counting).
 #pragma once
 
 #include <atomic>
@@ -12,9 +13,18 @@
 
 inline std::atomic<bool> gCounting{false};
 inline std::atomic<std::uint64_t> gAllocations{0};
+inline std::atomic<std::size_t> gLargestAllocation{0};
+
+inline void countAllocation(std::size_t size) {
+  if (!gCounting.load(std::memory_order_relaxed)) return;
+  gAllocations.fetch_add(1);
+  std::size_t seen = gLargestAllocation.load();
+  while (size > seen && !gLargestAllocation.compare_exchange_weak(seen, size)) {
+  }
+}
 
 void* operator new(std::size_t size) {
-  if (gCounting.load(std::memory_order_relaxed)) gAllocations.fetch_add(1);
+  countAllocation(size);
   if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
   throw std::bad_alloc();
 }
@@ -22,7 +32,7 @@ void* operator new[](std::size_t size) {
   return ::operator new(size);
 }
 void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
-  if (gCounting.load(std::memory_order_relaxed)) gAllocations.fetch_add(1);
+  countAllocation(size);
   return std::malloc(size == 0 ? 1 : size);
 }
 void* operator new[](std::size_t size, const std::nothrow_t& tag) noexcept {
