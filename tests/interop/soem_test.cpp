@@ -175,9 +175,11 @@ TEST(SoemV2, SimpleNgReportsAllSlavesOperational) {
   // shows as an occasional "wrong" iteration, which is the host's, not the network's. Its
   // state check right after may time out as well and print "Slave N lost" (seen once in CI:
   // iteration 9326 took 4 ms, the next ones had WKC 10 again), so a "lost" is tolerated
-  // only as the echo of a wrong iteration.
+  // only as the echo of a wrong iteration. Up to 0.3% of the 10000: 11 were seen on an idle
+  // machine and in CI on 2026-11-29 (the same day SOEM v2's redundant mode lost 0-18 frames
+  // per 5000 on a whole ring, v1 none), where a network fault costs every iteration after it.
   const int wrong = countMatches(out, "wrong \\(expected");
-  EXPECT_LE(wrong, 10) << out.substr(0, 4000);
+  EXPECT_LE(wrong, 30) << lines(out, "wrong");
   EXPECT_LE(countMatches(out, "\\* Slave [0-9]+ lost"), wrong)
       << lines(out, "Slave|AL|WARNING|ERROR|wrong");
   EXPECT_GE(
