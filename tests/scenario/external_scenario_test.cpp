@@ -291,6 +291,11 @@ TEST_F(ExternalScenario, EcmasterRecoversFromACableBreakAndFailsWithoutRecovery)
 // installed); a second, whole update must then succeed and be installed at the next power
 // cycle (2.0.0: the module was not bricked). A device that installed partial images fails the
 // "after the interrupted update" expectation (checked by hand: see the scenario's comment).
+// Not under AddressSanitizer (g++ defines __SANITIZE_ADDRESS__): the scenario's cut is timed
+// for a transfer that starts about 90 ms after the command does, and an instrumented ecmaster
+// took 2.3 s to read 0x100A before it (CI run of 2026-11-29), so the cut fell before the
+// transfer and nothing was interrupted.
+#if !defined(__SANITIZE_ADDRESS__)
 TEST_F(ExternalScenario, FirmwareUpdateInterruptedByACablePullKeepsTheOldFirmware) {
   ECSIM_REQUIRE_NETWORK();
   auto s = loadScenario(kSource / "scenarios/external/firmware_update_interrupted.xml");
@@ -321,6 +326,7 @@ TEST_F(ExternalScenario, FirmwareUpdateInterruptedByACablePullKeepsTheOldFirmwar
   EXPECT_LT(good, installed) << output;
   expectNoNamespaceLeft();
 }
+#endif  // !__SANITIZE_ADDRESS__
 
 TEST_F(ExternalScenario, SoemSimpleTestRunsToTheEndInOp) {
   ECSIM_REQUIRE_SOEM();
