@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <linux/capability.h>
+#include <poll.h>
 #include <sched.h>
 #include <spawn.h>
 #include <sys/random.h>
@@ -250,26 +251,42 @@ Result<ChildProcess> spawnProcess(const std::vector<std::string>& argv,
 }
 
 Result<CommandOutput> runCommand(const std::vector<std::string>& argv) {
-  std::array<int, 2> pipeFds{-1, -1};
-  if (::pipe2(pipeFds.data(), O_CLOEXEC) != 0) {
-    return makeError(ErrorCode::kIo, "pipe for '" + joinCommand(argv) + "': " + errnoText(errno));
-  }
-  UniqueFd readEnd(pipeFds[0]);
-  UniqueFd writeEnd(pipeFds[1]);
+  // One pipe per stream, so that a program's notes on stderr never stand inside what it
+  // prints on stdout for another program (JSON, a list): `output` keeps both, as a terminal
+  // would show them.
+  std::array<UniqueFd, 2> readEnds;
   SpawnSetup setup;
-  setup.duplicate(writeEnd.get(), 1);
-  setup.duplicate(writeEnd.get(), 2);
+  std::array<UniqueFd, 2> writeEnds;
+  for (std::size_t i = 0; i < readEnds.size(); ++i) {
+    std::array<int, 2> pipeFds{-1, -1};
+    if (::pipe2(pipeFds.data(), O_CLOEXEC) != 0) {
+      return makeError(ErrorCode::kIo, "pipe for '" + joinCommand(argv) + "': " + errnoText(errno));
+    }
+    readEnds[i] = UniqueFd(pipeFds[0]);
+    writeEnds[i] = UniqueFd(pipeFds[1]);
+    setup.duplicate(writeEnds[i].get(), static_cast<int>(i) + 1);
+  }
   ECSIM_ASSIGN_OR_RETURN(pid_t pid, setup.spawn(argv));
   ChildProcess child(pid);
-  writeEnd.reset();
+  for (auto& end : writeEnds) end.reset();
   CommandOutput result;
+  std::array<pollfd, 2> fds{pollfd{readEnds[0].get(), POLLIN, 0},
+                            pollfd{readEnds[1].get(), POLLIN, 0}};
   std::array<char, 4096> chunk{};
-  for (;;) {
-    const ssize_t n = ::read(readEnd.get(), chunk.data(), chunk.size());
-    if (n > 0) {
-      result.output.append(chunk.data(), static_cast<std::size_t>(n));
-    } else if (n == 0 || errno != EINTR) {
+  while (fds[0].fd >= 0 || fds[1].fd >= 0) {
+    if (::poll(fds.data(), fds.size(), -1) < 0) {
+      if (errno == EINTR) continue;
       break;
+    }
+    for (std::size_t i = 0; i < fds.size(); ++i) {
+      if (fds[i].fd < 0 || fds[i].revents == 0) continue;
+      const ssize_t n = ::read(fds[i].fd, chunk.data(), chunk.size());
+      if (n > 0) {
+        result.output.append(chunk.data(), static_cast<std::size_t>(n));
+        if (i == 0) result.standardOutput.append(chunk.data(), static_cast<std::size_t>(n));
+      } else if (n == 0 || errno != EINTR) {
+        fds[i].fd = -1;  // poll skips a negative descriptor
+      }
     }
   }
   ECSIM_ASSIGN_OR_RETURN(result.exitCode, child.wait(std::chrono::seconds(30)));

@@ -67,8 +67,9 @@ Result<ChildProcess> spawnProcess(const std::vector<std::string>& argv,
                                   const SpawnOptions& options = {});
 
 struct CommandOutput {
-  int exitCode{0};     // as ChildProcess::wait()
-  std::string output;  // stdout and stderr together
+  int exitCode{0};             // as ChildProcess::wait()
+  std::string output;          // stdout and stderr together, in the order they arrived
+  std::string standardOutput;  // stdout alone: what a program prints for other programs
 };
 // Runs a command to completion, collecting its output.
 Result<CommandOutput> runCommand(const std::vector<std::string>& argv);

@@ -19,7 +19,7 @@ CommandOutput run(std::vector<std::string> args) {
   args.insert(args.begin(), kEcmaster);
   auto out = runCommand(args);
   EXPECT_TRUE(out.ok());
-  return out.ok() ? *out : CommandOutput{-1, ""};
+  return out.ok() ? *out : CommandOutput{-1, "", ""};
 }
 
 // --sim TOPOLOGY names the slaves as the topology does (issue #16 item 3): DI1, Drive1.
@@ -27,7 +27,7 @@ TEST(EcmasterCyclic, JsonHasPercentilesEventsAndShownVariables) {
   auto out = run({"--sim", kDemo, "--json", "cyclic", "--seconds", "0.3", "--quiet", "--show",
                   "DI1.Input 3", "--show", "Drive1.Statusword"});
   ASSERT_EQ(out.exitCode, 0) << out.output;
-  auto j = nlohmann::json::parse(out.output, nullptr, false);
+  auto j = nlohmann::json::parse(out.standardOutput, nullptr, false);
   ASSERT_FALSE(j.is_discarded()) << out.output;
   EXPECT_EQ(j["cycles"], 300);
   const auto& rtt = j["roundTripUs"];
@@ -74,7 +74,7 @@ TEST(EcmasterCyclic, TextSummaryAndErrors) {
 TEST(EcmasterCyclic, SlavesAreNamedByTheTopologyTheConfigOrNames) {
   auto out = run({"--sim", kDemo, "--json", "slaves"});
   ASSERT_EQ(out.exitCode, 0) << out.output;
-  auto list = nlohmann::json::parse(out.output, nullptr, false);
+  auto list = nlohmann::json::parse(out.standardOutput, nullptr, false);
   ASSERT_TRUE(list.is_array()) << out.output;
   ASSERT_EQ(list.size(), 6u);
   EXPECT_EQ(list[4]["name"], "Drive1");

@@ -22,7 +22,7 @@ CommandOutput run(std::vector<std::string> args) {
   args.insert(args.begin(), kEcmaster);
   auto out = runCommand(args);
   EXPECT_TRUE(out.ok());
-  return out.ok() ? *out : CommandOutput{-1, ""};
+  return out.ok() ? *out : CommandOutput{-1, "", ""};
 }
 
 std::string el6601Topology() {
@@ -46,7 +46,7 @@ TEST(EcmasterEoe, SetsAndReadsBackTheIpParameters) {
   auto set = run({"--sim", topology, "--json", "eoe", "-p", "0", "ip=192.168.9.200",
                   "mask=255.255.255.0", "gw=192.168.9.1", "mac=02:00:00:00:00:2a", "name=switch1"});
   ASSERT_EQ(set.exitCode, 0) << set.output;
-  auto j = nlohmann::json::parse(set.output, nullptr, false);
+  auto j = nlohmann::json::parse(set.standardOutput, nullptr, false);
   ASSERT_FALSE(j.is_discarded()) << set.output;
   EXPECT_EQ(j["ip"], "192.168.9.200");
   EXPECT_EQ(j["mask"], "255.255.255.0");

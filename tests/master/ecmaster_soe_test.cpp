@@ -23,7 +23,7 @@ CommandOutput run(std::vector<std::string> args) {
   args.insert(args.begin(), kEcmaster);
   auto out = runCommand(args);
   EXPECT_TRUE(out.ok());
-  return out.ok() ? *out : CommandOutput{-1, ""};
+  return out.ok() ? *out : CommandOutput{-1, "", ""};
 }
 
 TEST(EcmasterSoe, ReadWithoutIdnListsEveryIdnOfTheDrive) {
@@ -45,7 +45,7 @@ TEST(EcmasterSoe, ReadWithoutIdnListsEveryIdnOfTheDrive) {
 TEST(EcmasterSoe, ReadsOneIdnWithItsElementsAndWritesItsValue) {
   auto out = run({"--sim", kSoeDrive, "--json", "soe", "read", "-p", "1", "S-0-0001"});
   ASSERT_EQ(out.exitCode, 0) << out.output;
-  auto j = nlohmann::json::parse(out.output, nullptr, false);
+  auto j = nlohmann::json::parse(out.standardOutput, nullptr, false);
   ASSERT_FALSE(j.is_discarded()) << out.output;
   EXPECT_EQ(j["name"], "Control unit cycle time (TNcyc)");
   EXPECT_EQ(j["attribute"], 0x60110001);
@@ -97,7 +97,7 @@ TEST(EcmasterSoe, ListsTheIdnsOfTheAx5021DictionaryInFragments) {
   auto out = run({"--sim", topology.string(), "--json", "soe", "read", "-p", "0"});
   std::filesystem::remove_all(dir);
   ASSERT_EQ(out.exitCode, 0) << out.output;
-  auto j = nlohmann::json::parse(out.output, nullptr, false);
+  auto j = nlohmann::json::parse(out.standardOutput, nullptr, false);
   ASSERT_FALSE(j.is_discarded()) << out.output;
   // S-0-0017 (238 bytes, three 128-byte mailboxes) names the dictionary's 119 objects.
   ASSERT_EQ(j["idns"].size(), 119u);

@@ -23,11 +23,11 @@ CommandOutput run(std::vector<std::string> args) {
   args.insert(args.begin(), kEcmaster);
   auto out = runCommand(args);
   EXPECT_TRUE(out.ok());
-  return out.ok() ? *out : CommandOutput{-1, ""};
+  return out.ok() ? *out : CommandOutput{-1, "", ""};
 }
 
 nlohmann::json json(const CommandOutput& out) {
-  auto j = nlohmann::json::parse(out.output, nullptr, false);
+  auto j = nlohmann::json::parse(out.standardOutput, nullptr, false);
   EXPECT_FALSE(j.is_discarded()) << out.output;
   return j;
 }
