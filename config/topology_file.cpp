@@ -83,7 +83,7 @@ const xml::Names kEniSlaveNames{{"name", "model", "stateFile"}, {"Input", "Param
 const xml::Names kMasterNames{{"cable", "redundant", "redundantCable"}};
 const xml::Names kSlaveNames{
     {"name", "esi", "product", "revision", "device", "eeprom", "esc", "dc", "processingDelayNs",
-     "forwardingDelayNs", "stateFile", "modules", "model", "soeDictionary"},
+     "forwardingDelayNs", "stateFile", "modules", "model", "soeDictionary", "alias", "deviceId"},
     {"Clock", "Input", "Param", "Module"},
     {"Clock"}};
 // <Slave model="...">: the device models a topology may choose (docs/devices.md).
@@ -175,6 +175,8 @@ Result<TopologySlave> parseSlave(const xml::Context& ctx, const Element* e,
                          attrInteger(ctx, e, "processingDelayNs", 0, kMaxEscDelayNs));
   ECSIM_ASSIGN_OR_RETURN(s.forwardingDelayNs,
                          attrInteger(ctx, e, "forwardingDelayNs", 0, kMaxEscDelayNs));
+  ECSIM_ASSIGN_OR_RETURN(s.alias, xml::attrNumber<std::uint16_t>(ctx, e, "alias"));
+  ECSIM_ASSIGN_OR_RETURN(s.deviceId, xml::attrNumber<std::uint16_t>(ctx, e, "deviceId"));
   if (const Element* clock = e->FirstChildElement("Clock")) {
     ECSIM_TRY(xml::checkNames(ctx, clock, kClockNames));
     ECSIM_ASSIGN_OR_RETURN(
@@ -193,7 +195,8 @@ Result<TopologySlave> parseSlave(const xml::Context& ctx, const Element* e,
   if (const char* moduleFile = e->Attribute("modules")) s.moduleFile = folder / moduleFile;
   if (const char* dict = e->Attribute("soeDictionary")) {
     if (s.esiFile.empty()) {
-      return ctx.error(e, "Slave '" + s.name + "': soeDictionary= needs a device from an ESI file (esi=)");
+      return ctx.error(
+          e, "Slave '" + s.name + "': soeDictionary= needs a device from an ESI file (esi=)");
     }
     s.soeDictionaryFile = folder / dict;
   }

@@ -74,6 +74,11 @@ struct TopologySlave {
   // SoE devices: the EtherCATDict file holding the drive's IDNs (soeDictionary=, resolved
   // against the topology file's folder).
   std::filesystem::path soeDictionaryFile;
+  // Identification (ETG.1020 §22 hot-connect; docs/topology.md): the configured station alias
+  // in the SII (word 4, loaded into 0x0012), and the explicit device ID the device shows in AL
+  // status code 0x0134 when a master requests it (AL control 0x0120 bit 5): an ID switch.
+  std::optional<std::uint16_t> alias;
+  std::optional<std::uint16_t> deviceId;
   int line{0};
 };
 

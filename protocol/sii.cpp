@@ -193,6 +193,14 @@ std::uint8_t siiChecksum(ConstBytes firstFourteenBytes) {
   return crc;
 }
 
+void setSiiStationAlias(std::vector<std::uint8_t>& image, std::uint16_t alias) {
+  const std::size_t checksumAt = sii::kWordChecksum * 2;
+  if (image.size() < checksumAt + 2) return;
+  const bool checksumRight = siiChecksum(image) == image[checksumAt];
+  writeLe16(image, sii::kWordStationAlias * 2, alias);
+  if (checksumRight) image[checksumAt] = siiChecksum(image);
+}
+
 std::uint16_t siiSizeFieldForBytes(std::size_t bytes) {
   std::size_t kbit = bytes * 8 / 1024;
   return static_cast<std::uint16_t>(kbit == 0 ? 0 : kbit - 1);

@@ -284,6 +284,10 @@ struct SiiContents {
 
 // CRC-8 of the configuration area (bytes 0..13), the low byte of word 7.
 std::uint8_t siiChecksum(ConstBytes firstFourteenBytes);
+// Writes the configured station alias (word 4, which the ESC loads into 0x0012) into an image
+// with its checksum renewed; an image whose checksum was wrong before keeps a wrong one (a
+// dump broken on purpose stays broken). Images too short to hold word 7 are left alone.
+void setSiiStationAlias(std::vector<std::uint8_t>& image, std::uint16_t alias);
 // EEPROM size field for a size in bytes (size must be a multiple of 128) and back.
 std::uint16_t siiSizeFieldForBytes(std::size_t bytes);
 std::size_t siiBytesForSizeField(std::uint16_t sizeField);

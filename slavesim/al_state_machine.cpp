@@ -26,7 +26,7 @@ int rank(AlState s) {
 }  // namespace
 
 std::uint16_t AlStateMachine::checkMailbox(const Esc& esc, const SlaveProfile::Mailbox& mbx,
-                                          AlStatusCode failure) const {
+                                           AlStatusCode failure) const {
   // SM0 must be a mailbox the master writes, SM1 one it reads, at the SII's offsets and no
   // larger than the SII's sizes (what slave stacks check at INIT->PREOP, and at INIT->BOOT
   // against the bootstrap layout: SOES ESC_checkmbx, AL status 0x0015 for BOOT).
@@ -161,6 +161,14 @@ void AlStateMachine::onAlControl(Esc& esc, const SlaveProfile& profile) {
   if (errorCode != 0) {
     esc.pdiSetAlStatus(
         static_cast<std::uint16_t>(static_cast<std::uint16_t>(current) | kAlErrorFlag), errorCode);
+  } else if (profile.explicitDeviceId && (control & reg::al::kDeviceIdentification) != 0 &&
+             next != AlState::kBootstrap) {
+    // Explicit Device ID requested (AL control bit 5): the ID in the status code register and
+    // AL status bit 5 "ID loaded", while no error is indicated and outside BOOT (what the
+    // Beckhoff slave stack's SetALStatus does); a request without it clears both.
+    esc.pdiSetAlStatus(static_cast<std::uint16_t>(static_cast<std::uint16_t>(next) |
+                                                  reg::al::kDeviceIdentification),
+                       *profile.explicitDeviceId);
   } else {
     esc.pdiSetAlStatus(static_cast<std::uint16_t>(next), 0);
   }

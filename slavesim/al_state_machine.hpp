@@ -40,6 +40,10 @@ struct SlaveProfile {
   };
   static constexpr std::uint16_t kNoSyncObject = 0xFFFF;
   Sync sync;
+  // Explicit Device ID (ETG.1020 §22.2.2; ESI Info/IdentificationReg134): the ID (an ID
+  // switch's value) the firmware shows in 0x0134, with AL status bit 5, while AL control bit 5
+  // requests it. nullopt: the device has none and ignores the request.
+  std::optional<std::uint16_t> explicitDeviceId;
 };
 
 class AlStateMachine {

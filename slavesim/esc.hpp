@@ -18,6 +18,7 @@
 #include "protocol/esc_blocks.hpp"
 #include "protocol/frame.hpp"
 #include "protocol/registers.hpp"
+#include "protocol/sii.hpp"
 #include "protocol/time.hpp"
 #include "slavesim/dc_clock.hpp"
 #include "slavesim/esc_register_table.hpp"
@@ -259,6 +260,9 @@ class Esc {
   void writeSiiByte(std::size_t offset, std::uint8_t value) {
     if (offset < sii_.size()) sii_[offset] = value;
   }
+  // Gives the EEPROM another configured station alias (word 4, checksum renewed: a topology's
+  // alias=); 0x0012 takes it at the next reload or power-on reset.
+  void setSiiStationAlias(std::uint16_t alias) { ecsim::setSiiStationAlias(sii_, alias); }
 
   // Power cycle: registers back to reset values, EEPROM content kept, reloaded.
   void powerOnReset();

@@ -328,6 +328,11 @@ Result<Network> buildNetwork(const TopologyConfig& config) {
       return e;
     }
     auto& made = *slave.value();
+    if (entry.alias) {  // in the EEPROM as delivered: loaded into 0x0012 from the start
+      made.esc().setSiiStationAlias(*entry.alias);
+      made.esc().powerOnReset();
+    }
+    if (entry.deviceId) made.profile().explicitDeviceId = entry.deviceId;
     made.esc().setDcUnit(entry.dc == "none"         ? slavesim::Esc::DcUnit::kNone
                          : entry.dc == "delay-only" ? slavesim::Esc::DcUnit::kDelayOnly
                                                     : slavesim::Esc::DcUnit::kFull);

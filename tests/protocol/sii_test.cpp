@@ -61,6 +61,27 @@ TEST(SiiChecksum, InitialValueIsFfNotZero) {
   EXPECT_NE(siiChecksum(zeros), 0x00);
 }
 
+// The configured station alias is word 4, inside the checksummed area: a new alias needs a new
+// checksum, or the ESC refuses the whole header (0x0502 bit 11). Starting from the real
+// EK1100 header above (checksum 0x46), alias 0x0102 gives the checksum of those bytes.
+TEST(SiiStationAlias, RenewsTheChecksum) {
+  std::vector<std::uint8_t> image = {0x00, 0x0d, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+                                     0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x46, 0x00};
+  ASSERT_EQ(siiChecksum(image), 0x46);
+  setSiiStationAlias(image, 0x0102);
+  EXPECT_EQ(readLe16(image, 8), 0x0102);
+  EXPECT_EQ(image[14], siiChecksum(image));
+  EXPECT_NE(image[14], 0x46);
+}
+
+TEST(SiiStationAlias, AWrongChecksumStaysWrong) {
+  std::vector<std::uint8_t> image(16, 0);
+  image[14] = static_cast<std::uint8_t>(siiChecksum(image) ^ 0xFF);  // broken on purpose
+  setSiiStationAlias(image, 7);
+  EXPECT_EQ(readLe16(image, 8), 7);
+  EXPECT_NE(image[14], siiChecksum(image));
+}
+
 TEST(SiiSize, FieldIsKbitMinusOne) {
   EXPECT_EQ(siiSizeFieldForBytes(256), 1);    // 2 Kbit (SOES_lan9252demo_slave.bin)
   EXPECT_EQ(siiSizeFieldForBytes(2048), 15);  // 16 Kbit (ek1100.hex)

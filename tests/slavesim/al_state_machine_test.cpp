@@ -77,6 +77,41 @@ TEST_F(Esm, UnknownStateCode) {
   EXPECT_EQ(code(), 0x0012);
 }
 
+// Explicit Device ID (ETG.1020 §22.2.2), as the Beckhoff slave stack's SetALStatus shows it:
+// while AL control bit 5 requests it, AL status bit 5 ("ID loaded") and the ID in 0x0134, but
+// only without an error indication; a request without bit 5 withdraws both.
+TEST_F(Esm, ExplicitDeviceIdShownWhileRequested) {
+  seg_.slave(0).profile().explicitDeviceId = 0x0105;
+  request(0x0021);  // INIT + ID request
+  EXPECT_EQ(status(), 0x0021);
+  EXPECT_EQ(code(), 0x0105);
+  request(0x0001);
+  EXPECT_EQ(status(), 0x0001);
+  EXPECT_EQ(code(), 0x0000);
+  configureMailbox();
+  request(0x0022);  // the request holds in any state outside BOOT
+  EXPECT_EQ(status(), 0x0022);
+  EXPECT_EQ(code(), 0x0105);
+}
+
+TEST_F(Esm, ExplicitDeviceIdGivesWayToAnError) {
+  seg_.slave(0).profile().explicitDeviceId = 0x0105;
+  request(0x0022);  // PREOP + ID request, mailbox not configured
+  EXPECT_EQ(status(), 0x0011) << "INIT + error, no ID";
+  EXPECT_EQ(code(), 0x0016);
+  request(0x0021);  // still an error: the request is ignored until acknowledged
+  EXPECT_EQ(code(), 0x0016);
+  request(0x0031);  // acknowledged, ID requested
+  EXPECT_EQ(status(), 0x0021);
+  EXPECT_EQ(code(), 0x0105);
+}
+
+TEST_F(Esm, DeviceWithoutExplicitDeviceIdIgnoresTheRequest) {
+  request(0x0021);
+  EXPECT_EQ(status(), 0x0001);
+  EXPECT_EQ(code(), 0x0000);
+}
+
 TEST_F(Esm, BootstrapNotSupportedWithoutBootMailbox) {
   request(0x0003);
   EXPECT_EQ(code(), 0x0013);

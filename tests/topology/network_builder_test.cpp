@@ -45,6 +45,29 @@ TEST(NetworkBuilder, UnknownEscTypeNamesTheSlave) {
   EXPECT_NE(net.error().context.find("ET9999"), std::string::npos);
 }
 
+// alias= is written into the EEPROM (word 4, checksum renewed) and loaded into 0x0012;
+// deviceId= is the ID the firmware shows for an ID request (AL control bit 5).
+TEST(NetworkBuilder, AliasAndExplicitDeviceIdReachTheDevice) {
+  auto cfg = parseTopology(
+      "<Topology>\n<Slave name=\"A\" alias=\"0x0203\" deviceId=\"12\"/>\n<Slave name=\"B\"/>\n"
+      "</Topology>",
+      "t.xml");
+  ASSERT_TRUE(cfg.ok()) << cfg.error().message();
+  auto net = topology::buildNetwork(*cfg);
+  ASSERT_TRUE(net.ok()) << net.error().message();
+  auto& seg = *net->segment;
+  EXPECT_EQ(readLe16(one(seg, Command::kAprd, phys(0, 0x0012), {0, 0}).data, 0), 0x0203);
+  EXPECT_EQ(readLe16(seg.slave(0).esc().sii(), 8), 0x0203);
+  EXPECT_EQ(seg.slave(0).esc().sii()[14], siiChecksum(seg.slave(0).esc().sii()));
+  EXPECT_EQ(seg.slave(0).profile().explicitDeviceId, std::optional<std::uint16_t>(12));
+  EXPECT_EQ(seg.slave(1).esc().reg16(0x0012), 0);
+  EXPECT_FALSE(seg.slave(1).profile().explicitDeviceId);
+  auto wide =
+      parseTopology("<Topology>\n<Slave name=\"A\" deviceId=\"70000\"/>\n</Topology>", "t.xml");
+  ASSERT_FALSE(wide.ok());
+  EXPECT_NE(wide.error().message().find("line 2"), std::string::npos) << wide.error().message();
+}
+
 TEST(NetworkBuilder, PortBeyondTheEscIsRefused) {
   auto cfg = parseTopology(
       "<Topology>\n<Slave name=\"A\" esc=\"LAN9252\"/>\n<Slave name=\"B\"/>\n"
@@ -71,8 +94,8 @@ TEST(NetworkBuilder, MoreSlavesThanTheAddressSpaceAreRefused) {
 // An EEPROM image must be a regular file of at most 1 MiB: a device or a FIFO named there is
 // refused with its path, not read without end or waited on.
 TEST(NetworkBuilder, EepromImageThatIsNotARegularFileIsRefused) {
-  auto zero = parseTopology("<Topology>\n<Slave name=\"E\" eeprom=\"/dev/zero\"/>\n</Topology>",
-                            "t.xml");
+  auto zero =
+      parseTopology("<Topology>\n<Slave name=\"E\" eeprom=\"/dev/zero\"/>\n</Topology>", "t.xml");
   ASSERT_TRUE(zero.ok()) << zero.error().message();
   auto net = topology::buildNetwork(*zero);
   ASSERT_FALSE(net.ok());
@@ -83,9 +106,8 @@ TEST(NetworkBuilder, EepromImageThatIsNotARegularFileIsRefused) {
   const auto fifo = std::filesystem::temp_directory_path() /
                     ("ecsim-eeprom-fifo-" + std::to_string(::getpid()) + ".bin");
   ASSERT_TRUE(makeFifo(fifo));
-  auto cfg = parseTopology("<Topology>\n<Slave name=\"E\" eeprom=\"" + fifo.string() +
-                               "\"/>\n</Topology>",
-                           "t.xml");
+  auto cfg = parseTopology(
+      "<Topology>\n<Slave name=\"E\" eeprom=\"" + fifo.string() + "\"/>\n</Topology>", "t.xml");
   ASSERT_TRUE(cfg.ok()) << cfg.error().message();
   auto built = readWithoutHanging(fifo, [&] { return topology::buildNetwork(*cfg); });
   std::filesystem::remove(fifo);
