@@ -11,8 +11,8 @@ namespace {
 constexpr std::uint16_t kEepromReadLength = static_cast<std::uint16_t>(
     reg::kSiiData.address + reg::kSiiData.width - reg::kSiiControlStatus.address);
 constexpr std::size_t kEepromDataOffset = reg::kSiiData.address - reg::kSiiControlStatus.address;
-constexpr std::size_t kIdentityBytes = 8;             // vendor id, product code
-constexpr std::uint16_t kPdoAssignmentBase = 0x1C10;  // + SM number
+constexpr std::size_t kIdentityBytes = 8;               // vendor id, product code
+constexpr std::uint16_t kPdoAssignmentBase = 0x1C10;    // + SM number
 constexpr std::uint16_t kSpeedCounterRestart = 0x1000;  // 0x0930, as the DC set-up writes it
 
 std::string hex(unsigned v, int digits) {
@@ -313,6 +313,7 @@ bool SlaveRecoveryTask::stepIdentity(SimTime now) {
     fail(s);
     return false;
   }
+  if (sub_ == Sub::kAlias || sub_ == Sub::kDeviceId) return stepIdentification(now);
   if (sub_ == Sub::kEepromPoll) {
     const ConstBytes answer = batch_[0].data();
     const std::uint16_t status = readLe16(answer, 0);
@@ -335,7 +336,17 @@ bool SlaveRecoveryTask::stepIdentity(SimTime now) {
                                                           describeIdentity(known)));
           return false;
         }
-        enter(Stage::kMailbox, now);
+        // The same kind of device; is it the same one? Its alias, and its Explicit Device ID
+        // when it showed one at the scan (a tool changer's tools are alike but for these).
+        batch_.clear();
+        batch_.add().fprd(slave_.station, reg::kConfiguredStationAlias);
+        if (slave_.deviceId) {
+          batch_.add().fpwr(slave_.station, reg::kAlControl,
+                            static_cast<std::uint16_t>(static_cast<std::uint16_t>(AlState::kInit) |
+                                                       reg::al::kDeviceIdentification));
+        }
+        batch_.queueAll(transport_);
+        sub_ = Sub::kAlias;
         return true;
       }
       batch_.clear();
@@ -359,6 +370,42 @@ bool SlaveRecoveryTask::stepIdentity(SimTime now) {
   batch_.add().fprd(slave_.station, reg::kSiiControlStatus.address, kEepromReadLength);
   batch_.queueAll(transport_);
   sub_ = Sub::kEepromPoll;
+  return true;
+}
+
+// Alias read (and ID requested), then the AL status polled until the ID shows (ETG.1020
+// §22.2.2: AL status bit 5 with the ID in 0x0134); the recovery's deadline bounds the wait.
+bool SlaveRecoveryTask::stepIdentification(SimTime now) {
+  auto differs = [&](const char* what, unsigned found, unsigned expected) {
+    fail(makeError(ErrorCode::kInvalidArgument,
+                   "another device answers at position " + std::to_string(slave_.position) + ": " +
+                       describeIdentity(slave_.identity()) + " with " + what + " " +
+                       std::to_string(found) + ", expected " + std::to_string(expected)));
+    return false;
+  };
+  if (sub_ == Sub::kAlias) {
+    const std::uint16_t alias = batch_[0].get(reg::kConfiguredStationAlias);
+    if (alias != slave_.alias) return differs("station alias (0x0012)", alias, slave_.alias);
+    if (!slave_.deviceId) {
+      enter(Stage::kMailbox, now);
+      return true;
+    }
+  } else {
+    const std::uint16_t status = batch_[0].get(reg::kAlStatus);
+    if ((status & (reg::al::kDeviceIdentification | kAlErrorFlag)) ==
+        reg::al::kDeviceIdentification) {
+      const std::uint16_t id = batch_[0].get(reg::kAlStatusCode);
+      if (id != *slave_.deviceId) {
+        return differs("explicit device ID (0x0134)", id, *slave_.deviceId);
+      }
+      enter(Stage::kMailbox, now);  // its INIT->PREOP request withdraws the ID request
+      return true;
+    }
+  }
+  batch_.clear();
+  batch_.add().fprd(slave_.station, reg::kAlStatus, reg::kAlStatusCode);
+  batch_.queueAll(transport_);
+  sub_ = Sub::kDeviceId;
   return true;
 }
 

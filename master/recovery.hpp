@@ -144,6 +144,8 @@ class SlaveRecoveryTask final : public Task {
     kWrites,
     kEepromCommand,
     kEepromPoll,
+    kAlias,
+    kDeviceId,
     kDcLatch,
     kDcRead,
     kDcWrite
@@ -152,6 +154,7 @@ class SlaveRecoveryTask final : public Task {
   void enter(Stage stage, SimTime now);
   void fail(Status status);
   bool stepIdentity(SimTime now);
+  bool stepIdentification(SimTime now);
   bool stepStateChange(AlState target, Stage next, SimTime now);
   void queueEepromRead(std::uint32_t word);
   void startWrites(AlState target);

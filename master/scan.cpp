@@ -10,7 +10,7 @@ namespace ecsim::master {
 namespace {
 
 // Register reads of the scan, in the order queued per slave.
-constexpr std::size_t kReadsPerSlave = 5;
+constexpr std::size_t kReadsPerSlave = 6;
 
 // SII General category defaults for the mailbox control bytes (SOEM's values, §3.2).
 constexpr std::uint8_t kMailboxOutControl = 0x26;
@@ -127,8 +127,8 @@ void ScanTask::adviseTimeout() {
   // ESCs pass a frame on as its bits arrive: a full-size frame takes as long as the count
   // frame through the slaves and then its extra length on the wire (docs/timing.md).
   const SimTime extra = static_cast<SimTime>(kMaxFrameSize - kMinFrameSize) * kNsPerByte100Mbit;
-  advice.needed = static_cast<SimTime>(options_.timeoutMargin *
-                                       static_cast<double>(advice.roundTrip + extra));
+  advice.needed =
+      static_cast<SimTime>(options_.timeoutMargin * static_cast<double>(advice.roundTrip + extra));
   advice.before = transport_.options().timeout;
   if (options_.adaptTimeout && advice.needed > advice.before) {
     transport_.setTimeout(advice.needed);
@@ -164,8 +164,11 @@ void ScanTask::queueDefaults() {
     batch_.add().write(Command::kBwr, 0, r, value, 0);
   };
   // INIT with error acknowledge first; its WKC is checked (every slave must take it).
+  // With the ID request (bit 5, ETG.1020 §22.2.2): a slave with an Explicit Device ID shows
+  // it in 0x0134 by the register read; the next AL control write (INIT->PREOP) withdraws it.
   batch_.add().write(Command::kBwr, 0, reg::kAlControl,
-                     static_cast<std::uint16_t>(kAlErrorFlag | static_cast<std::uint16_t>(AlState::kInit)),
+                     static_cast<std::uint16_t>(kAlErrorFlag | reg::al::kDeviceIdentification |
+                                                static_cast<std::uint16_t>(AlState::kInit)),
                      n);
   // The other writes are best effort: an ESC without DC, say, need not count them.
   bwr(static_cast<std::uint16_t>(reg::kDlControl.address + 1), {0});  // loop control: auto
@@ -208,11 +211,63 @@ void ScanTask::queueRegisters() {
     batch_.add().fprd(slave.station, reg::kDlStatus);
     batch_.add().fprd(slave.station, reg::kAlStatus, reg::kAlStatusCode);
     batch_.add().fprd(slave.station, reg::kSiiControlStatus);
+    batch_.add().fprd(slave.station, reg::kAlEventRequest);
   }
   batch_.queueAll(transport_);
 }
 
-void ScanTask::takeRegisters() {
+namespace {
+
+// AL status and code as read; with bit 5 and no error flag the code register holds the
+// Explicit Device ID (an ESC in device emulation copies the request into AL status with the
+// error flag of the reset, and so shows none). True once the firmware has looked at the
+// request: the ID shows, an error does, or it has read AL control (0x0220 bit 0 clear).
+bool takeAlStatus(SlaveInfo& slave, std::uint16_t status, std::uint16_t code,
+                  std::uint32_t alEvents) {
+  slave.alStatus = status;
+  slave.alStatusCode = code;
+  slave.deviceId = std::nullopt;
+  if ((status & (reg::al::kDeviceIdentification | kAlErrorFlag)) ==
+      reg::al::kDeviceIdentification) {
+    slave.deviceId = code;
+    slave.alStatusCode = 0;  // the register holds the ID, not an error
+  }
+  return slave.deviceId || (status & kAlErrorFlag) != 0 ||
+         (alEvents & reg::al_event::kAlControl) == 0;
+}
+
+}  // namespace
+
+void ScanTask::queueIdentify() {
+  batch_.clear();
+  for (std::size_t position : identifying_) {
+    const std::uint16_t station = slaves_[position].station;
+    batch_.add().fprd(station, reg::kAlStatus, reg::kAlStatusCode);
+    batch_.add().fprd(station, reg::kAlEventRequest);
+  }
+  batch_.queueAll(transport_);
+}
+
+// False when no slave is left to wait for.
+bool ScanTask::takeIdentify(SimTime now) {
+  std::size_t kept = 0;
+  for (std::size_t k = 0; k < identifying_.size(); ++k) {
+    SlaveInfo& slave = slaves_[identifying_[k]];
+    const Datagram& status = batch_[2 * k];
+    if (!takeAlStatus(slave, status.get(reg::kAlStatus), status.get(reg::kAlStatusCode),
+                      batch_[2 * k + 1].get(reg::kAlEventRequest))) {
+      identifying_[kept++] = identifying_[k];
+    }
+  }
+  identifying_.resize(kept);
+  if (identifying_.empty() || now >= identifyUntil_) return false;
+  queueIdentify();
+  return true;
+}
+
+void ScanTask::takeRegisters(SimTime now) {
+  identifying_.clear();
+  identifyUntil_ = now + options_.identifyWait;
   for (auto& slave : slaves_) {
     const std::size_t base = slave.position * kReadsPerSlave;
     const Datagram& info = batch_[base];
@@ -226,8 +281,11 @@ void ScanTask::takeRegisters() {
     slave.features = info.get(reg::kEscFeatures);
     slave.alias = batch_[base + 1].get(reg::kConfiguredStationAlias);
     slave.dlStatus = batch_[base + 2].get(reg::kDlStatus);
-    slave.alStatus = batch_[base + 3].get(reg::kAlStatus);
-    slave.alStatusCode = batch_[base + 3].get(reg::kAlStatusCode);
+    if (!takeAlStatus(slave, batch_[base + 3].get(reg::kAlStatus),
+                      batch_[base + 3].get(reg::kAlStatusCode),
+                      batch_[base + 5].get(reg::kAlEventRequest))) {
+      identifying_.push_back(slave.position);
+    }
     slave.siiReads8Bytes =
         (batch_[base + 4].get(reg::kSiiControlStatus) & reg::sii::kReadSize8Bytes) != 0;
   }
@@ -350,7 +408,22 @@ bool ScanTask::step(SimTime now) {
       if (auto s = batch_.check(); !s.ok()) {
         return fail(makeError(s.error().code, "slave registers: " + s.error().context));
       }
-      takeRegisters();
+      takeRegisters(now);
+      if (!identifying_.empty()) {
+        queueIdentify();
+        state_ = State::kIdentify;
+        return true;
+      }
+      [[fallthrough]];
+    }
+    case State::kIdentify: {
+      if (state_ == State::kIdentify) {
+        if (batch_.pending()) return true;
+        if (auto s = batch_.check(); !s.ok()) {
+          return fail(makeError(s.error().code, "explicit device IDs: " + s.error().context));
+        }
+        if (takeIdentify(now)) return true;
+      }
       batch_.clear();
       if (!options_.readSii) {
         state_ = State::kDone;

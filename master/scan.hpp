@@ -7,7 +7,12 @@
 //               reset, EEPROM handed to the EtherCAT side (0x0500 = 2 then 0)
 //   addresses   APWR 0x0010 = firstStation + position, one per slave
 //   registers   FPRD per slave: ESC information 0x0000-0x0009, alias 0x0012, DL status
-//               0x0110, AL status and code 0x0130-0x0135, EEPROM control 0x0502
+//               0x0110, AL status and code 0x0130-0x0135, AL event request 0x0220, EEPROM
+//               control 0x0502
+//   identify    the reset asked for every Explicit Device ID (AL control bit 5): AL status
+//               and 0x0220 read again for the slaves whose firmware has not yet read AL
+//               control, until it has (bit 0 of 0x0220 clear) and shows the ID or not, at
+//               most ScanOptions::identifyWait
 //   SII         every slave's EEPROM at once (one SiiReader each; their datagrams share
 //               frames), then parsed: identity, name, mailbox, categories. A pass steps only
 //               the readers whose datagram came back or whose poll interval is over, in
@@ -54,15 +59,18 @@ struct ScanOptions {
   // needed frame timeout exceeds the default one: it is meant for a network whose frames fit
   // the default.
   bool adaptFramesInFlight{true};
+  // How long the scan waits for firmware to take the ID request (a slave whose firmware does
+  // not read AL control in that time is recorded without an ID).
+  SimTime identifyWait{100 * kNsPerMs};
 };
 
 // What the count told about the frame timeout (ScanOptions::adaptTimeout).
 struct TimeoutAdvice {
   std::size_t slaves{0};
-  SimTime roundTrip{0};  // of the count frame, measured
-  SimTime needed{0};     // timeoutMargin x (roundTrip + a full frame's extra wire time)
-  SimTime before{0};     // the transport's timeout when the count came back
-  bool raised{false};    // the transport's timeout was set to `needed`
+  SimTime roundTrip{0};          // of the count frame, measured
+  SimTime needed{0};             // timeoutMargin x (roundTrip + a full frame's extra wire time)
+  SimTime before{0};             // the transport's timeout when the count came back
+  bool raised{false};            // the transport's timeout was set to `needed`
   std::size_t framesFitting{0};  // full-size frames the line holds during one round trip
   std::size_t framesBefore{0};   // the transport's frames in flight when the count came back
   bool framesRaised{false};      // the transport may now keep min(framesFitting, 255) in flight
@@ -81,13 +89,25 @@ class ScanTask final : public Task {
   const std::optional<TimeoutAdvice>& timeoutAdvice() const { return advice_; }
 
  private:
-  enum class State { kIdle, kCount, kDefaults, kAddresses, kRegisters, kSii, kDone, kFailed };
+  enum class State {
+    kIdle,
+    kCount,
+    kDefaults,
+    kAddresses,
+    kRegisters,
+    kIdentify,
+    kSii,
+    kDone,
+    kFailed
+  };
 
   void adviseTimeout();
   void queueDefaults();
   void queueAddresses();
   void queueRegisters();
-  void takeRegisters();
+  void takeRegisters(SimTime now);
+  void queueIdentify();
+  bool takeIdentify(SimTime now);
   void startSii(SimTime now);
   bool stepSii(SimTime now);
   void afterStep(std::uint32_t reader);
@@ -112,6 +132,10 @@ class ScanTask final : public Task {
   std::vector<std::uint32_t> inFlight_;  // scratch: readers whose frame is on the wire
   std::size_t siiRunning_{0};
   std::optional<TimeoutAdvice> advice_;
+  // Slaves whose firmware has not yet taken the ID request of the reset, and until when the
+  // scan waits for them.
+  std::vector<std::size_t> identifying_;
+  SimTime identifyUntil_{0};
 };
 
 // Each slave's active ports from its DL status, and its parent from the active ports of all

@@ -30,6 +30,10 @@ struct SlaveInfo {
   std::size_t position{0};   // 0 = the slave next to the master
   std::uint16_t station{0};  // configured station address (0x1001 + position)
   std::uint16_t alias{0};    // 0x0012
+  // Explicit Device ID (ETG.1020 §22.2.2): what the slave showed in 0x0134, with AL status
+  // bit 5 and no error, for the ID request of the scan's reset; nullopt when it showed none
+  // (no such ID, or not yet by the register read).
+  std::optional<std::uint16_t> deviceId;
   // ESC information (0x0000-0x0009)
   std::uint8_t escType{0};
   std::uint8_t escRevision{0};

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "master/state_change.hpp"
+#include "tests/master/bring_up.hpp"
 #include "tests/master/sim_network.hpp"
 #include "tests/master/test_slaves.hpp"
 
@@ -64,8 +65,8 @@ TEST(ScanTest, RaisesTheFrameTimeoutToWhatTheCountedLineNeeds) {
     EXPECT_EQ(transport.options().timeout, adapt ? advice.needed : 2 * kNsPerMs);
     // The round trip of over 2 ms holds 17 full frames (1514 bytes at 80 ns: 121.12 us each),
     // more than the 16 in flight by default.
-    EXPECT_EQ(advice.framesFitting, static_cast<std::size_t>(
-                                        (advice.roundTrip + 1514 * 80 - 1) / (1514 * 80)));
+    EXPECT_EQ(advice.framesFitting,
+              static_cast<std::size_t>((advice.roundTrip + 1514 * 80 - 1) / (1514 * 80)));
     EXPECT_EQ(advice.framesFitting, 17u);
     EXPECT_EQ(advice.framesBefore, 16u);
     EXPECT_EQ(advice.framesRaised, adapt);
@@ -101,6 +102,45 @@ TEST(ScanTest, ItsOwnTimeoutGrowsWithTheFrameTimeoutTheLineNeeds) {
       EXPECT_GT(task.timeoutScale(), 2.0);
     }
   }
+}
+
+// The reset asks every slave for its Explicit Device ID (AL control bit 5, ETG.1020 §22.2.2):
+// Drive1 has one, AI1 none (its firmware reads AL control and shows nothing), a generic slave
+// is an ESC in device emulation (it copies the request with the reset's error flag: no ID),
+// and Drive2's firmware does not run (EEPROM checksum error: nothing reads AL control, 0x0220
+// bit 0 stays set), which the scan waits for at most ScanOptions::identifyWait.
+TEST(ScanTest, AsksForExplicitDeviceIdsAndWaitsBoundedForFirmwareThatNeverLooks) {
+  SimTime took[2]{};
+  for (const SimTime wait : {SimTime{100 * kNsPerMs}, SimTime{0}}) {
+    SimNetwork net;
+    net.segment().addSlave(makeDemoSlave(0x7201, "Drive1"));
+    net.segment().addSlave(makeDemoSlave(0x3102, "AI1"));
+    net.segment().addSlave(slavesim::makeGenericSlave("G", 1));
+    net.segment().addSlave(makeDemoSlave(0x7201, "Drive2"));
+    net.segment().wireLine();
+    net.segment().slave(0).profile().explicitDeviceId = 7;
+    auto& silent = net.segment().slave(3);
+    constexpr std::size_t kChecksumByte = 14;  // SII word 7, low byte
+    silent.esc().writeSiiByte(kChecksumByte,
+                              static_cast<std::uint8_t>(silent.esc().sii()[kChecksumByte] ^ 1));
+    net.start();
+    silent.powerOff();  // on again with the broken EEPROM
+    silent.powerOn(net.clock().now());
+    ASSERT_FALSE(silent.firmwareRunning());
+    ASSERT_FALSE(net.segment().slave(1).esc().deviceEmulation());
+    ASSERT_TRUE(net.segment().slave(2).esc().deviceEmulation());
+    const SimTime before = net.clock().now();
+    master::ScanOptions options;
+    options.identifyWait = wait;
+    auto s = scan(net, options);
+    ASSERT_TRUE(s.status.ok()) << s.status.error().message();
+    took[wait == 0 ? 1 : 0] = net.clock().now() - before;
+    EXPECT_EQ(s.slaves[0].deviceId, std::optional<std::uint16_t>(7));
+    EXPECT_EQ(s.slaves[0].alStatusCode, 0) << "0x0134 held the ID, not an error";
+    for (std::size_t i : {1, 2, 3}) EXPECT_FALSE(s.slaves[i].deviceId) << i;
+  }
+  EXPECT_GE(took[0] - took[1], 95 * kNsPerMs) << took[0] << " vs " << took[1];
+  EXPECT_LE(took[0] - took[1], 105 * kNsPerMs) << took[0] << " vs " << took[1];
 }
 
 TEST(ScanTest, LeavesTheTimeoutOfAShortLineAlone) {
