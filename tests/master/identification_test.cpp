@@ -34,10 +34,10 @@ class IdentificationTest : public ::testing::Test {
     change(sim(i));
     sim(i).powerOn(net_.clock().now());
   }
-  const master::MasterEvent* findEvent(MasterEventKind kind, std::size_t position) const {
-    return testing::findEvent(master_->events(), kind, position);
+  const master::MasterEvent* event(MasterEventKind kind, std::size_t position) const {
+    return findEvent(master_->events(), kind, position);
   }
-  std::string eventLog() const { return testing::eventLog(master_->events()); }
+  std::string log() const { return eventLog(master_->events()); }
   slavesim::Slave& sim(std::size_t i) { return net_.segment().slave(i); }
 
   SimNetwork net_;
@@ -57,25 +57,25 @@ TEST_F(IdentificationTest, TheScanRecordsTheExplicitDeviceIdOfSlavesThatHaveOne)
 TEST_F(IdentificationTest, AToolWithAnotherIdIsNotBroughtToOp) {
   swap(kDrive, [](slavesim::Slave& s) { s.profile().explicitDeviceId = 9; });
   runCycles(*master_, net_, 300);
-  const auto* failed = findEvent(MasterEventKind::kRecoveryFailed, kDrive);
-  ASSERT_NE(failed, nullptr) << eventLog();
+  const auto* failed = event(MasterEventKind::kRecoveryFailed, kDrive);
+  ASSERT_NE(failed, nullptr) << log();
   EXPECT_NE(failed->text.find("explicit device ID (0x0134) 9, expected 5"), std::string::npos)
       << failed->text;
-  EXPECT_EQ(findEvent(MasterEventKind::kSlaveRecovered, kDrive), nullptr) << eventLog();
+  EXPECT_EQ(event(MasterEventKind::kSlaveRecovered, kDrive), nullptr) << log();
   EXPECT_EQ(sim(kDrive).state(), AlState::kInit);
   EXPECT_EQ(runCycles(*master_, net_, 100), 0u);  // the others run on clean
   // The right tool back on: the next attempt (every 1000 cycles) brings it to OP.
   swap(kDrive, [](slavesim::Slave& s) { s.profile().explicitDeviceId = kToolId; });
   runCycles(*master_, net_, 1500);
-  EXPECT_NE(findEvent(MasterEventKind::kSlaveRecovered, kDrive), nullptr) << eventLog();
+  EXPECT_NE(event(MasterEventKind::kSlaveRecovered, kDrive), nullptr) << log();
   EXPECT_EQ(sim(kDrive).state(), AlState::kOp);
 }
 
 TEST_F(IdentificationTest, ADeviceWithAnotherAliasIsNotBroughtToOp) {
   swap(kAi, [](slavesim::Slave& s) { s.esc().setSiiStationAlias(7); });
   runCycles(*master_, net_, 300);
-  const auto* failed = findEvent(MasterEventKind::kRecoveryFailed, kAi);
-  ASSERT_NE(failed, nullptr) << eventLog();
+  const auto* failed = event(MasterEventKind::kRecoveryFailed, kAi);
+  ASSERT_NE(failed, nullptr) << log();
   EXPECT_NE(failed->text.find("station alias (0x0012) 7, expected 0"), std::string::npos)
       << failed->text;
   EXPECT_NE(sim(kAi).state(), AlState::kOp);
@@ -84,8 +84,8 @@ TEST_F(IdentificationTest, ADeviceWithAnotherAliasIsNotBroughtToOp) {
 TEST_F(IdentificationTest, TheSameDeviceComesBack) {
   swap(kDrive, [](slavesim::Slave&) {});
   runCycles(*master_, net_, 500);
-  EXPECT_NE(findEvent(MasterEventKind::kSlaveRecovered, kDrive), nullptr) << eventLog();
-  EXPECT_EQ(findEvent(MasterEventKind::kRecoveryFailed, kDrive), nullptr) << eventLog();
+  EXPECT_NE(event(MasterEventKind::kSlaveRecovered, kDrive), nullptr) << log();
+  EXPECT_EQ(event(MasterEventKind::kRecoveryFailed, kDrive), nullptr) << log();
   EXPECT_EQ(sim(kDrive).state(), AlState::kOp);
 }
 
