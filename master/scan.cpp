@@ -165,7 +165,8 @@ void ScanTask::queueDefaults() {
   };
   // INIT with error acknowledge first; its WKC is checked (every slave must take it).
   // With the ID request (bit 5, ETG.1020 §22.2.2): a slave with an Explicit Device ID shows
-  // it in 0x0134 by the register read; the next AL control write (INIT->PREOP) withdraws it.
+  // it in 0x0134 (register read, identify); the next AL control write (INIT->PREOP) withdraws
+  // it.
   batch_.add().write(Command::kBwr, 0, reg::kAlControl,
                      static_cast<std::uint16_t>(kAlErrorFlag | reg::al::kDeviceIdentification |
                                                 static_cast<std::uint16_t>(AlState::kInit)),

@@ -32,7 +32,7 @@ struct SlaveInfo {
   std::uint16_t alias{0};    // 0x0012
   // Explicit Device ID (ETG.1020 §22.2.2): what the slave showed in 0x0134, with AL status
   // bit 5 and no error, for the ID request of the scan's reset; nullopt when it showed none
-  // (no such ID, or not yet by the register read).
+  // (no such ID, or its firmware did not take the request within ScanOptions::identifyWait).
   std::optional<std::uint16_t> deviceId;
   // ESC information (0x0000-0x0009)
   std::uint8_t escType{0};
