@@ -58,7 +58,8 @@ std::size_t FoeFile::copyOut(std::size_t offset, Bytes out) const {
     const std::vector<std::uint8_t>& chunk = chunks_[offset / kChunkBytes];
     const std::size_t at = offset % kChunkBytes;
     const std::size_t n = std::min(out.size() - copied, chunk.size() - at);
-    std::copy_n(chunk.begin() + static_cast<std::ptrdiff_t>(at), n, out.begin() + static_cast<std::ptrdiff_t>(copied));
+    std::copy_n(chunk.begin() + static_cast<std::ptrdiff_t>(at), n,
+                out.begin() + static_cast<std::ptrdiff_t>(copied));
     copied += n;
     offset += n;
   }
