@@ -391,12 +391,10 @@ bool SlaveRecoveryTask::stepIdentification(SimTime now) {
       return true;
     }
   } else {
-    const std::uint16_t status = batch_[0].get(reg::kAlStatus);
-    if ((status & (reg::al::kDeviceIdentification | kAlErrorFlag)) ==
-        reg::al::kDeviceIdentification) {
-      const std::uint16_t id = batch_[0].get(reg::kAlStatusCode);
-      if (id != *slave_.deviceId) {
-        return differs("explicit device ID (0x0134)", id, *slave_.deviceId);
+    if (const auto id =
+            explicitDeviceId(batch_[0].get(reg::kAlStatus), batch_[0].get(reg::kAlStatusCode))) {
+      if (*id != *slave_.deviceId) {
+        return differs("explicit device ID (0x0134)", *id, *slave_.deviceId);
       }
       enter(Stage::kMailbox, now);  // its INIT->PREOP request withdraws the ID request
       return true;

@@ -219,20 +219,15 @@ void ScanTask::queueRegisters() {
 
 namespace {
 
-// AL status and code as read; with bit 5 and no error flag the code register holds the
-// Explicit Device ID (an ESC in device emulation copies the request into AL status with the
-// error flag of the reset, and so shows none). True once the firmware has looked at the
-// request: the ID shows, an error does, or it has read AL control (0x0220 bit 0 clear).
+// AL status and code as read, and the Explicit Device ID they carry (explicitDeviceId). True once
+// the firmware has looked at the request: the ID shows, an error does, or it has read AL control
+// (0x0220 bit 0 clear).
 bool takeAlStatus(SlaveInfo& slave, std::uint16_t status, std::uint16_t code,
                   std::uint32_t alEvents) {
   slave.alStatus = status;
   slave.alStatusCode = code;
-  slave.deviceId = std::nullopt;
-  if ((status & (reg::al::kDeviceIdentification | kAlErrorFlag)) ==
-      reg::al::kDeviceIdentification) {
-    slave.deviceId = code;
-    slave.alStatusCode = 0;  // the register holds the ID, not an error
-  }
+  slave.deviceId = explicitDeviceId(status, code);
+  if (slave.deviceId) slave.alStatusCode = 0;  // the register holds the ID, not an error
   return slave.deviceId || (status & kAlErrorFlag) != 0 ||
          (alEvents & reg::al_event::kAlControl) == 0;
 }

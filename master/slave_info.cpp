@@ -32,6 +32,12 @@ std::string describeAlStatusCode(std::uint16_t code) {
   return std::string(buf) + " (" + std::string(alStatusCodeText(code)) + ")";
 }
 
+std::optional<std::uint16_t> explicitDeviceId(std::uint16_t alStatus, std::uint16_t alStatusCode) {
+  const std::uint16_t shown = alStatus & (reg::al::kDeviceIdentification | kAlErrorFlag);
+  if (shown != reg::al::kDeviceIdentification) return std::nullopt;
+  return alStatusCode;
+}
+
 std::string describeIdentity(const SiiIdentity& identity) {
   char buf[96];
   std::snprintf(buf, sizeof buf, "vendor 0x%08X product 0x%08X revision 0x%08X", identity.vendorId,

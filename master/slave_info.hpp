@@ -84,6 +84,10 @@ struct SlaveInfo {
 std::string describeAlStatus(std::uint16_t alStatus);
 // "0x001D (Invalid output configuration)"
 std::string describeAlStatusCode(std::uint16_t code);
+// The Explicit Device ID an AL status/status code pair carries (ETG.1020 §22.2.2: bit 5 set
+// and no error flag, the ID in 0x0134); nullopt otherwise (an ESC in device emulation copies
+// the request bit into AL status with the error flag, and so shows none).
+std::optional<std::uint16_t> explicitDeviceId(std::uint16_t alStatus, std::uint16_t alStatusCode);
 // "vendor 0x00000E5C product 0x00001008 revision 0x00010000"
 std::string describeIdentity(const SiiIdentity& identity);
 
