@@ -7,6 +7,7 @@
 #include "slavesim/coe/standard_objects.hpp"
 #include "slavesim/devices/device_models.hpp"
 #include "slavesim/eoe/eoe_server.hpp"
+#include "slavesim/foe/foe_folder.hpp"
 #include "slavesim/foe/foe_server.hpp"
 #include "slavesim/generic_slave.hpp"
 #include "slavesim/soe/soe_server.hpp"
@@ -91,13 +92,20 @@ Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiDevice& device, std::st
   // BOOT: the bootstrap mailbox layout of the SII (ESI <Eeprom><BootStrap>).
   const SiiMailbox& boot = sii.bootstrapMailbox;
   if (profile.mailbox && boot.receiveSize > 0 && boot.sendSize > 0) {
-    profile.bootstrapMailbox = SlaveProfile::Mailbox{boot.receiveOffset, boot.receiveSize,
-                                                     boot.sendOffset, boot.sendSize};
+    profile.bootstrapMailbox =
+        SlaveProfile::Mailbox{boot.receiveOffset, boot.receiveSize, boot.sendOffset, boot.sendSize};
   }
   // FoE: in the mailbox states when the ESI mailbox names it, in BOOT whenever there is one.
+  // With a state file the files outlive the simulator, beside it (foe_folder.hpp); what was
+  // kept there is booted now, as at any power-up.
   std::shared_ptr<foe::FoeFiles> foeFiles;
   if (profile.mailbox && (device.mailbox.foe || profile.bootstrapMailbox)) {
-    foeFiles = std::make_shared<foe::FoeFiles>();
+    if (options.stateFile.empty()) {
+      foeFiles = std::make_shared<foe::FoeFiles>();
+    } else {
+      ECSIM_ASSIGN_OR_RETURN(foeFiles, foe::FoeFiles::keptIn(foe::foeFolderFor(options.stateFile)));
+      ECSIM_TRY(foe::installFirmware(*foeFiles, *od));
+    }
   }
 
   // 0x1018 says what the SII says (they differ when a vendor image carries another identity).
@@ -124,9 +132,8 @@ Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiDevice& device, std::st
   if (options.deviceModels) {
     devices::DeviceModelOptions modelOptions = options.models;
     if (!options.stateFile.empty()) modelOptions.stateFile = options.stateFile;
-    const bool driveObjects =
-        od->findEntry(devices::cia402::obj::kControlword, 0) != nullptr &&
-        od->findEntry(devices::cia402::obj::kStatusword, 0) != nullptr;
+    const bool driveObjects = od->findEntry(devices::cia402::obj::kControlword, 0) != nullptr &&
+                              od->findEntry(devices::cia402::obj::kStatusword, 0) != nullptr;
     devices::DeviceModelKind kind = options.model.value_or(devices::deviceModelFor(
         sii.identity.vendorId, sii.identity.productCode, device.profileNo, driveObjects));
     if (!options.model && kind == devices::DeviceModelKind::kNone &&
@@ -139,14 +146,13 @@ Result<std::unique_ptr<Slave>> makeSlaveFromEsi(const EsiDevice& device, std::st
     ECSIM_TRY(devices::attachDeviceModel(*pd, kind, modelOptions));
     // A power cycle re-creates the model as built here (plus what outlives the power) and
     // boots the firmware written over FoE in BOOT, if any.
-    pd->setRestart([kind, modelOptions, foeFiles](ProcessDataDevice& d) {
-      if (foeFiles) foe::installFirmware(*foeFiles, d.dictionary());
+    pd->setRestart([kind, modelOptions, foeFiles](ProcessDataDevice& d) -> Status {
+      if (foeFiles) ECSIM_TRY(foe::installFirmware(*foeFiles, d.dictionary()));
       return devices::restartDeviceModel(d, kind, modelOptions);
     });
   } else if (foeFiles) {
     pd->setRestart([foeFiles](ProcessDataDevice& d) {
-      foe::installFirmware(*foeFiles, d.dictionary());
-      return okStatus();
+      return foe::installFirmware(*foeFiles, d.dictionary());
     });
   }
 

@@ -53,7 +53,8 @@ struct EsiSlaveOptions {
   // The model a topology names (model="cia402|io|analog|loopback|none"); unset: the choice above.
   std::optional<devices::DeviceModelKind> model;
   // Persistent device state (a drive's shaft position), TopologySlave::stateFile; when set it
-  // wins over models.stateFile.
+  // wins over models.stateFile. A device with FoE keeps its files in the folder beside it
+  // (foe::foeFolderFor, foe_folder.hpp).
   std::filesystem::path stateFile;
   // Parameters of the device model (devices/device_params.hpp). A drive's emergencies go to
   // the slave's CoE server unless models.emergencies is set.

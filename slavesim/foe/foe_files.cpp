@@ -1,5 +1,7 @@
 #include "slavesim/foe/foe_files.hpp"
 
+#include "slavesim/foe/foe_folder.hpp"
+
 #include <algorithm>
 #include <array>
 
@@ -102,9 +104,48 @@ std::shared_ptr<const FoeFile> FoeFiles::share(const std::string& name) const {
   return it == files_.end() ? nullptr : it->second;
 }
 
-void FoeFiles::store(const std::string& name, FoeFile data, bool writtenInBoot) {
+FoeFiles::FoeFiles() = default;
+FoeFiles::~FoeFiles() = default;
+
+Result<std::shared_ptr<FoeFiles>> FoeFiles::keptIn(const std::filesystem::path& folder) {
+  FoeFolderContent content;
+  ECSIM_ASSIGN_OR_RETURN(auto opened, FoeFolder::open(folder, content, kMaxFoeFileBytes));
+  auto files = std::make_shared<FoeFiles>();
+  for (auto& [name, file] : content.files) {
+    files->files_[name] = std::make_shared<const FoeFile>(std::move(file));
+  }
+  files->pending_ = std::move(content.pending);
+  files->installedVersion_ = std::move(content.installedVersion);
+  files->folder_ = std::make_unique<FoeFolder>(std::move(opened));
+  if (files->pending_ && files->find(*files->pending_) == nullptr) {
+    return makeError(ErrorCode::kInvalidArgument, (folder / "firmware").string() +
+                                                      ": the pending image '" + *files->pending_ +
+                                                      "' is not in the folder");
+  }
+  ECSIM_TRY(files->installPending());
+  return files;
+}
+
+Status FoeFiles::beginWrite(const std::string& name) {
+  return folder_ ? folder_->begin(name) : okStatus();
+}
+
+Status FoeFiles::appendWrite(ConstBytes bytes) {
+  return folder_ ? folder_->append(bytes) : okStatus();
+}
+
+void FoeFiles::abandonWrite() {
+  if (folder_) folder_->abandon();
+}
+
+Status FoeFiles::store(const std::string& name, FoeFile data, bool writtenInBoot) {
+  if (folder_) {
+    ECSIM_TRY(folder_->finish());
+    if (writtenInBoot) ECSIM_TRY(folder_->saveFirmwareRecord(name, installedVersion_));
+  }
   files_[name] = std::make_shared<const FoeFile>(std::move(data));
   if (writtenInBoot) pending_ = name;
+  return okStatus();
 }
 
 std::size_t FoeFiles::totalBytes() const {
@@ -113,12 +154,13 @@ std::size_t FoeFiles::totalBytes() const {
   return n;
 }
 
-void FoeFiles::installPending() {
-  if (!pending_) return;
+Status FoeFiles::installPending() {
+  if (!pending_) return okStatus();
   if (const auto* image = find(*pending_); image != nullptr) {
     if (auto version = softwareVersionIn(*image)) installedVersion_ = std::move(version);
   }
   pending_.reset();
+  return folder_ ? folder_->saveFirmwareRecord(pending_, installedVersion_) : okStatus();
 }
 
 }  // namespace ecsim::slavesim::foe

@@ -8,9 +8,12 @@
 // marker "ECSIM-SW-VERSION=" followed by a version text (up to a NUL, CR, LF or the end, at
 // most kMaxVersionLength characters), the device reports that text as its software version
 // (CiA 301 object 0x100A) from then on; an image without the marker changes nothing.
+// With a folder (keptIn, foe_folder.hpp: the slave's stateFile) the files, the pending image and
+// the installed version also outlive the simulator.
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <optional>
@@ -19,6 +22,7 @@
 #include <vector>
 
 #include "protocol/bytes.hpp"
+#include "protocol/result.hpp"
 
 namespace ecsim::slavesim::foe {
 
@@ -56,19 +60,42 @@ class FoeFile {
   std::size_t size_{0};
 };
 
+class FoeFolder;
+
+// The largest file a slave takes (a bigger write is refused with "disk full") or loads.
+inline constexpr std::size_t kMaxFoeFileBytes = 16u * 1024 * 1024;
+
 class FoeFiles {
  public:
+  FoeFiles();
+  ~FoeFiles();
+  FoeFiles(const FoeFiles&) = delete;
+  FoeFiles& operator=(const FoeFiles&) = delete;
+
+  // Files kept in `folder` (foe_folder.hpp) as well as in memory: what it holds is loaded, and
+  // an image pending there is installed (starting the simulator powers the device up).
+  static Result<std::shared_ptr<FoeFiles>> keptIn(const std::filesystem::path& folder);
+  // The folder, if kept in one.
+  const FoeFolder* folder() const { return folder_.get(); }
+
   const FoeFile* find(const std::string& name) const;
   // The file, shared: a read in progress keeps the bytes it started with, even if the file is
   // written again meanwhile, without copying them.
   std::shared_ptr<const FoeFile> share(const std::string& name) const;
-  void store(const std::string& name, FoeFile data, bool writtenInBoot);
+  // A write in progress also goes to the folder, packet by packet, so that storing costs a
+  // rename and not the whole file (no-ops without a folder). An error: the host could not
+  // write it (the FoE server answers "disk full").
+  Status beginWrite(const std::string& name);
+  Status appendWrite(ConstBytes bytes);
+  void abandonWrite();
+  // The file written completely (renamed into place in the folder first).
+  Status store(const std::string& name, FoeFile data, bool writtenInBoot);
   std::size_t totalBytes() const;
 
   // The name of the last file completely written in BOOT, waiting for the next power cycle.
   const std::optional<std::string>& pendingFirmware() const { return pending_; }
   // Called at a power cycle: the pending image becomes the running firmware.
-  void installPending();
+  Status installPending();
   // The software version the running firmware reports (set by installPending from an image
   // with the marker; empty: the version the device was built with).
   const std::optional<std::string>& installedVersion() const { return installedVersion_; }
@@ -77,6 +104,7 @@ class FoeFiles {
   std::map<std::string, std::shared_ptr<const FoeFile>> files_;
   std::optional<std::string> pending_;
   std::optional<std::string> installedVersion_;
+  std::unique_ptr<FoeFolder> folder_;
 };
 
 }  // namespace ecsim::slavesim::foe

@@ -27,10 +27,10 @@ bool inBoot(const Esc& esc) {
 
 }  // namespace
 
-void installFirmware(FoeFiles& files, coe::ObjectDictionary& od) {
-  files.installPending();
+Status installFirmware(FoeFiles& files, coe::ObjectDictionary& od) {
+  ECSIM_TRY(files.installPending());
   const std::optional<std::string>& version = files.installedVersion();
-  if (!version) return;
+  if (!version) return okStatus();
   std::string name = "Software version";
   std::uint16_t accessBits = coe::access::kReadOnly;
   if (const coe::Object* o = od.find(coe::kSoftwareVersionIndex); o != nullptr) {
@@ -38,12 +38,14 @@ void installFirmware(FoeFiles& files, coe::ObjectDictionary& od) {
     if (!o->entries.empty()) accessBits = o->entries.front().access;
   }
   od.addString(coe::kSoftwareVersionIndex, name, *version, accessBits);
+  return okStatus();
 }
 
 FoeServer::FoeServer(std::shared_ptr<FoeFiles> files, FoeServerOptions options)
     : files_(files ? std::move(files) : std::make_shared<FoeFiles>()), options_(options) {}
 
 void FoeServer::reset() {
+  if (transfer_ == Transfer::kWriting) files_->abandonWrite();
   transfer_ = Transfer::kIdle;
   name_.clear();
   writing_ = FoeFile();
@@ -93,6 +95,7 @@ void FoeServer::onWriteRequest(const Esc& esc, const FoePacket& p, MailboxReplie
   name_.assign(p.text());
   writingInBoot_ = inBoot(esc);
   busyLeft_ = options_.busyResponses;
+  if (!files_->beginWrite(name_).ok()) return sendError(replies, FoeErrorCode::kDiskFull);
   replies.send(encodeFoeMailbox(FoeOpcode::kAck, 0));
 }
 
@@ -110,12 +113,16 @@ void FoeServer::onData(const Esc& esc, const FoePacket& p, MailboxReplies& repli
   if (writing_.size() + p.data.size() > options_.maxFileSize) {
     return sendError(replies, FoeErrorCode::kDiskFull);
   }
+  if (!files_->appendWrite(p.data).ok()) return sendError(replies, FoeErrorCode::kDiskFull);
   writing_.append(p.data);
   packet_ = p.value;
   const bool last = p.data.size() < foeDataPerPacket(receiveMailboxSize(esc));
   if (last) {
+    transfer_ = Transfer::kIdle;  // stored or failed: nothing left to abandon
+    if (!files_->store(name_, std::move(writing_), writingInBoot_).ok()) {
+      return sendError(replies, FoeErrorCode::kDiskFull);
+    }
     ++counters_.filesWritten;
-    files_->store(name_, std::move(writing_), writingInBoot_);
     const std::uint32_t n = packet_;
     reset();
     replies.send(encodeFoeMailbox(FoeOpcode::kAck, n));

@@ -14,7 +14,8 @@
 //          password other than the configured one 0x800A (no rights, as SOES); a packet number
 //          other than the expected 0x8005; DATA or ACK without a transfer, an unknown opcode
 //          or an empty file name 0x8004 (illegal); a file beyond maxFileSize 0x8003 (disk
-//          full); any FoE request outside BOOT on a device whose FoE lives only in its
+//          full; so is a file the host cannot write into the slave's FoE folder,
+//          foe_folder.hpp); any FoE request outside BOOT on a device whose FoE lives only in its
 //          bootloader (ESI BootStrap without Mailbox/FoE) 0x8008 (bootstrap only). An ERR from
 //          the master ends the transfer without an answer.
 // Each request gets at most one answer (the final ACK of a read none), so the endpoint's retry
@@ -36,12 +37,13 @@ namespace ecsim::slavesim::foe {
 // A power cycle of a slave with FoE files: the image written in BOOT becomes the running
 // firmware (FoeFiles::installPending) and the version it carries, if any, is what 0x100A
 // reports (the object keeps its name and access; its length follows the text).
-void installFirmware(FoeFiles& files, coe::ObjectDictionary& od);
+// An error: the folder the files are kept in could not record it (foe_folder.hpp).
+Status installFirmware(FoeFiles& files, coe::ObjectDictionary& od);
 
 struct FoeServerOptions {
   bool outsideBoot{true};  // FoE also in PREOP, SAFEOP and OP (ESI Mailbox/FoE)
   std::uint32_t password{0};
-  std::size_t maxFileSize{16u * 1024 * 1024};
+  std::size_t maxFileSize{kMaxFoeFileBytes};
   unsigned busyResponses{0};
 };
 
