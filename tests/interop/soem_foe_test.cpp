@@ -4,7 +4,8 @@
 // (words 0x14-0x17) and writes a file with ecx_FOEwrite (password 0); our master reads it back
 // over FoE in BOOT (`ecmaster foe read --boot`) and gets the same bytes; after a power cycle
 // (`ecsim ctl power-cycle`) the slave reports the version the image carries in 0x100A
-// (`ecmaster upload 0x100A:00`), as docs/devices.md "Firmware update over FoE" describes.
+// (`ecmaster upload 0x100A:00`), as docs/devices.md "Firmware update over FoE" describes; with
+// the slave's stateFile the same holds across a restart of `ecsim serve`.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -43,7 +44,8 @@ Ran runIn(VethNamespace& ns, std::vector<std::string> argv, const std::string& l
 
 void writeFile(const std::string& path, const std::vector<std::uint8_t>& bytes) {
   std::ofstream out(path, std::ios::binary);
-  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  out.write(reinterpret_cast<const char*>(bytes.data()),
+            static_cast<std::streamsize>(bytes.size()));
 }
 
 std::vector<std::uint8_t> readBytes(const std::string& path) {
@@ -51,7 +53,11 @@ std::vector<std::uint8_t> readBytes(const std::string& path) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-void firmwareUpdateThroughSoem(const std::string& program, const std::string& version) {
+// restart: the slave has a stateFile, and instead of the power cycle `ecsim serve` is stopped
+// and started again on the same topology (the files kept beside the state file; docs/devices.md
+// "Firmware update over FoE").
+void firmwareUpdateThroughSoem(const std::string& program, const std::string& version,
+                               bool restart = false) {
   ECSIM_REQUIRE_SOEM();
   ECSIM_REQUIRE_SHARED(kSoesEsi);
   ASSERT_TRUE(std::filesystem::exists(kSoem / program)) << kSoem / program;
@@ -61,7 +67,9 @@ void firmwareUpdateThroughSoem(const std::string& program, const std::string& ve
   {
     std::ofstream t(topology);
     t << "<Topology name=\"foe\">\n  <Slave name=\"Soes\" esi=\"" << kSoesEsi.string()
-      << "\" product=\"#x4D2\"/>\n</Topology>\n";
+      << "\" product=\"#x4D2\"";
+    if (restart) t << " stateFile=\"foe_state_" << tag << "\"";
+    t << "/>\n</Topology>\n";
   }
   // 1000 bytes (8 packets of 116 through the 128-byte bootstrap mailbox and one of 72) with
   // the version marker inside.
@@ -76,17 +84,23 @@ void firmwareUpdateThroughSoem(const std::string& program, const std::string& ve
   ASSERT_TRUE(ns.ok()) << ns.error().message();
   const std::string socket = dir + "foe_ctl_" + tag + ".sock";
   const std::string serveLog = dir + "foe_serve_" + tag + ".log";
-  auto server = ns->spawn({kEcsim, "serve", "--rt", "--iface", ns->simulatorInterface(),
-                           "--control", socket, topology},
-                          SpawnOptions{serveLog, serveLog});
-  ASSERT_TRUE(server.ok()) << server.error().message();
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
-  while (readText(serveLog).find("ecsim: control socket") == std::string::npos &&
-         server->running() && std::chrono::steady_clock::now() < deadline) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  ASSERT_NE(readText(serveLog).find("ecsim: control socket"), std::string::npos)
-      << readText(serveLog);
+  auto serve = [&] {
+    std::filesystem::remove(serveLog);
+    auto server = ns->spawn({kEcsim, "serve", "--rt", "--iface", ns->simulatorInterface(),
+                             "--control", socket, topology},
+                            SpawnOptions{serveLog, serveLog});
+    EXPECT_TRUE(server.ok()) << server.error().message();
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+    while (server.ok() && readText(serveLog).find("ecsim: control socket") == std::string::npos &&
+           server->running() && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    EXPECT_NE(readText(serveLog).find("ecsim: control socket"), std::string::npos)
+        << readText(serveLog);
+    return server;
+  };
+  auto server = serve();
+  ASSERT_TRUE(server.ok());
 
   // SOEM: slave 1, the file by its path (firm_update sends argv[3] as the FoE file name).
   const Ran soem = runIn(*ns,
@@ -99,10 +113,10 @@ void firmwareUpdateThroughSoem(const std::string& program, const std::string& ve
 
   // Our master reads it back in BOOT.
   const std::string readBack = dir + "foe_back_" + tag + ".bin";
-  const Ran read = runIn(*ns,
-                         {kEcmaster, "-i", ns->masterInterface(), "foe", "read", "--boot",
-                          imagePath, "-o", readBack},
-                         dir + "foe_read_" + tag + ".log", std::chrono::seconds(60));
+  const Ran read = runIn(
+      *ns,
+      {kEcmaster, "-i", ns->masterInterface(), "foe", "read", "--boot", imagePath, "-o", readBack},
+      dir + "foe_read_" + tag + ".log", std::chrono::seconds(60));
   EXPECT_EQ(read.status, 0) << read.out;
   EXPECT_EQ(readBytes(readBack), image);
 
@@ -114,9 +128,16 @@ void firmwareUpdateThroughSoem(const std::string& program, const std::string& ve
   };
   const Ran before = upload();  // the ESI's STRING(0): empty, or refused
   EXPECT_EQ(before.out.find(version), std::string::npos) << before.out;
-  const Ran cycle = runIn(*ns, {kEcsim, "ctl", "--socket", socket, "power-cycle", "slave=Soes"},
-                          dir + "foe_cycle_" + tag + ".log", std::chrono::seconds(20));
-  EXPECT_EQ(cycle.status, 0) << cycle.out;
+  if (restart) {
+    (void)server->kill(SIGINT);
+    (void)server->wait(std::chrono::seconds(5));
+    server = serve();
+    ASSERT_TRUE(server.ok());
+  } else {
+    const Ran cycle = runIn(*ns, {kEcsim, "ctl", "--socket", socket, "power-cycle", "slave=Soes"},
+                            dir + "foe_cycle_" + tag + ".log", std::chrono::seconds(20));
+    EXPECT_EQ(cycle.status, 0) << cycle.out;
+  }
   const Ran after = upload();
   EXPECT_EQ(after.status, 0) << after.out;
   // The value is the last line (ecmaster may say something about the frame timeout first, on
@@ -124,10 +145,21 @@ void firmwareUpdateThroughSoem(const std::string& program, const std::string& ve
   const std::string tail = after.out.substr(after.out.rfind('\n', after.out.size() - 2) + 1);
   EXPECT_EQ(tail, version + "\n") << after.out;
 
+  if (restart) {
+    // The restarted simulator still has the file SOEM wrote.
+    std::filesystem::remove(readBack);
+    const Ran again = runIn(*ns,
+                            {kEcmaster, "-i", ns->masterInterface(), "foe", "read", "--boot",
+                             imagePath, "-o", readBack},
+                            dir + "foe_read_" + tag + ".log", std::chrono::seconds(60));
+    EXPECT_EQ(again.status, 0) << again.out;
+    EXPECT_EQ(readBytes(readBack), image);
+  }
   EXPECT_TRUE(server->running()) << "ecsim serve died:\n" << readText(serveLog);
   (void)server->kill(SIGINT);
   (void)server->wait(std::chrono::seconds(5));
   for (const auto& f : {topology, imagePath, readBack, serveLog}) std::filesystem::remove(f);
+  std::filesystem::remove_all(dir + "foe_state_" + tag + ".foe");
 }
 
 TEST(SoemV1Foe, FirmUpdateWritesInBootOurMasterReadsItBackNewVersionAfterPowerCycle) {
@@ -136,6 +168,11 @@ TEST(SoemV1Foe, FirmUpdateWritesInBootOurMasterReadsItBackNewVersionAfterPowerCy
 
 TEST(SoemV2Foe, FirmUpdateWritesInBootOurMasterReadsItBackNewVersionAfterPowerCycle) {
   firmwareUpdateThroughSoem("bin-v2/firm_update", "2.0.0-fw");
+}
+
+// The firmware kept with the slave's state file: booted by the next `ecsim serve`.
+TEST(SoemV1Foe, FirmwareKeptWithTheStateFileBootsAfterARestartOfTheSimulator) {
+  firmwareUpdateThroughSoem("bin-v1/firm_update", "1.4.0-kept", true);
 }
 
 }  // namespace
