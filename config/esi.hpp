@@ -258,6 +258,12 @@ struct EsiDevice {
   bool invisible{false};
   bool useLrdLwr{false};
   std::optional<std::int32_t> ebusCurrent;  // mA
+  // How a master reads the device's ID switch (ETG.2000 Info, ETG.1020 explicit device
+  // identification): at an address of the ESC memory (IdentificationAdo, e.g. an EK1101's
+  // 0x1000, where its ESC in digital I/O mode keeps the switch's inputs), or in 0x0134 on
+  // request through AL control bit 5 (IdentificationReg134).
+  std::optional<std::uint16_t> identificationAdo;
+  bool identificationReg134{false};
   std::optional<std::uint32_t> profileNo;
   std::string imageName;  // <Image16x14> (a name; ImageData16x14 blobs are not kept)
   std::vector<EsiFmmu> fmmus;

@@ -252,6 +252,10 @@ Result<EsiDevice> readDevice(const Context& ctx, const Element* e, const Element
     ECSIM_ASSIGN_OR_RETURN(out.ebusCurrent,
                            xml::childNumber<std::int32_t>(
                                ctx, electrical != nullptr ? electrical : info, "EBusCurrent"));
+    ECSIM_ASSIGN_OR_RETURN(out.identificationAdo,
+                           xml::childNumber<std::uint16_t>(ctx, info, "IdentificationAdo"));
+    const std::string_view reg134 = xml::childText(info, "IdentificationReg134");
+    out.identificationReg134 = reg134 == "1" || reg134 == "true";
   }
   for (const Element* profile : Children(e, "Profile")) {
     ECSIM_ASSIGN_OR_RETURN(auto number, xml::childNumber<std::uint32_t>(ctx, profile, "ProfileNo"));

@@ -44,6 +44,14 @@ struct SlaveProfile {
   // switch's value) the firmware shows in 0x0134, with AL status bit 5, while AL control bit 5
   // requests it. nullopt: the device has none and ignores the request.
   std::optional<std::uint16_t> explicitDeviceId;
+  // The ID kept at an address of the process memory instead (ESI Info/IdentificationAdo: an
+  // EK1101's ESC, in digital I/O mode without a microcontroller, samples the ID switch into
+  // 0x1000): written there through the PDI when the slave starts and at every power-up.
+  struct AdoDeviceId {
+    std::uint16_t address{0};
+    std::uint16_t value{0};
+  };
+  std::optional<AdoDeviceId> adoDeviceId;
 };
 
 class AlStateMachine {

@@ -17,6 +17,12 @@ void Slave::powerOn(SimTime now) {
   firmwareRunning_ = (esc_.reg16(reg::kDlStatus.address) & reg::dl_status::kPdiOperational) != 0;
   started_ = true;  // the power-up state was taken at the first start (or is taken now)
   coldStartStatus_ = device_ ? device_->coldStart() : okStatus();
+  showAdoDeviceId();
+}
+
+void Slave::showAdoDeviceId() {
+  if (!profile_.adoDeviceId || !firmwareRunning_) return;
+  esc_.pdiWrite16(profile_.adoDeviceId->address, profile_.adoDeviceId->value);
 }
 
 void Slave::poll(SimTime now) {
@@ -25,6 +31,7 @@ void Slave::poll(SimTime now) {
   if (!started_) {
     started_ = true;
     if (device_) device_->powerUp();
+    showAdoDeviceId();
   }
   if (events.alControlWritten) {
     // The firmware reads AL control through the PDI, which frees it for the master's next

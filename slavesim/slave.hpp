@@ -122,6 +122,9 @@ class Slave {
   const Status& coldStartStatus() const { return coldStartStatus_; }
 
  private:
+  // SlaveProfile::adoDeviceId into the process memory (when the firmware/PDI runs).
+  void showAdoDeviceId();
+
   std::string name_;
   Esc esc_;
   SlaveProfile profile_;

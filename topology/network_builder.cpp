@@ -51,6 +51,31 @@ Result<std::unique_ptr<slavesim::Slave>> makeFromEeprom(const TopologySlave& ent
   return std::make_unique<slavesim::Slave>(entry.name, esc, std::move(image), std::move(profile));
 }
 
+// A device whose ESI says where its ID is read (Info/IdentificationAdo, without
+// IdentificationReg134: an EK1101, whose ESC in digital I/O mode samples the ID switch into
+// 0x1000) keeps the ID there, and in the input PDO entry mapped at that address (its TxPDO "ID",
+// 0x6000:01), so a master reads it at the address in any state and in the process data in
+// SAFEOP and OP. No 0x0134 answer: such an ESC runs without a microcontroller.
+void showDeviceIdAtAdo(std::uint16_t id, const EsiDevice& device, slavesim::Slave& slave) {
+  const std::uint16_t ado = *device.identificationAdo;
+  slave.profile().adoDeviceId = slavesim::SlaveProfile::AdoDeviceId{ado, id};
+  auto* od = slavesim::objectDictionaryOf(slave);
+  for (std::size_t sm = 0; od != nullptr && sm < device.syncManagers.size(); ++sm) {
+    if (device.syncManagers[sm].startAddress != ado) continue;
+    for (const auto& pdo : device.txPdos) {
+      if (pdo.sm != sm || pdo.entries.empty() || pdo.entries.front().index == 0) continue;
+      const EsiPdoEntry& first = pdo.entries.front();
+      const auto* e = od->findEntry(first.index, first.subIndex);
+      if (e == nullptr) return;
+      std::array<std::uint8_t, 8> raw{};
+      writeLe16(raw, 0, id);
+      (void)od->setBytes(first.index, first.subIndex,
+                         ConstBytes(raw.data(), std::min<std::size_t>(e->byteSize(), 2)));
+      return;
+    }
+  }
+}
+
 }  // namespace
 
 Result<std::unique_ptr<slavesim::Slave>> SlaveFactory::make(const TopologySlave& entry) {
@@ -161,6 +186,9 @@ Result<std::unique_ptr<slavesim::Slave>> SlaveFactory::make(const TopologySlave&
     }
   } else if (!entry.inputs.empty()) {
     return at(entry, "this device has no objects to set inputs on");
+  }
+  if (entry.deviceId && configured.identificationAdo && !configured.identificationReg134) {
+    showDeviceIdAtAdo(*entry.deviceId, configured, **slave);
   }
   return slave;
 }
@@ -332,7 +360,19 @@ Result<Network> buildNetwork(const TopologyConfig& config) {
       made.esc().setSiiStationAlias(*entry.alias);
       made.esc().powerOnReset();
     }
-    if (entry.deviceId) made.profile().explicitDeviceId = entry.deviceId;
+    if (entry.deviceId && !made.profile().adoDeviceId) {
+      // An ESC in device emulation has no firmware to answer the ID request (AL control bit
+      // 5): the deviceId would show nowhere.
+      if (made.esc().deviceEmulation()) {
+        return makeError(ErrorCode::kInvalidArgument,
+                         config.file.string() + ", line " + std::to_string(entry.line) +
+                             ", slave '" + entry.name +
+                             "': deviceId on a device whose ESC runs in device emulation (no "
+                             "firmware answers the ID request in 0x0134) and whose ESI names no "
+                             "IdentificationAdo to read it at");
+      }
+      made.profile().explicitDeviceId = entry.deviceId;
+    }
     made.esc().setDcUnit(entry.dc == "none"         ? slavesim::Esc::DcUnit::kNone
                          : entry.dc == "delay-only" ? slavesim::Esc::DcUnit::kDelayOnly
                                                     : slavesim::Esc::DcUnit::kFull);

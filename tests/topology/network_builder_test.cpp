@@ -48,10 +48,13 @@ TEST(NetworkBuilder, UnknownEscTypeNamesTheSlave) {
 // alias= is written into the EEPROM (word 4, checksum renewed) and loaded into 0x0012;
 // deviceId= is the ID the firmware shows for an ID request (AL control bit 5).
 TEST(NetworkBuilder, AliasAndExplicitDeviceIdReachTheDevice) {
-  auto cfg = parseTopology(
-      "<Topology>\n<Slave name=\"A\" alias=\"0x0203\" deviceId=\"12\"/>\n<Slave name=\"B\"/>\n"
-      "</Topology>",
-      "t.xml");
+  // A: a drive with firmware (a generic slave runs in device emulation and is refused a
+  // deviceId: AnEk1101ShowsItsIdSwitchAtItsIdentificationAdo).
+  auto cfg = parseTopology("<Topology>\n<Slave name=\"A\" esi=\"" + std::string(ECSIM_SOURCE_DIR) +
+                               "/examples/esi/ecsim_devices.xml\" product=\"#x00007201\" "
+                               "alias=\"0x0203\" deviceId=\"12\"/>\n<Slave name=\"B\"/>\n"
+                               "</Topology>",
+                           "t.xml");
   ASSERT_TRUE(cfg.ok()) << cfg.error().message();
   auto net = topology::buildNetwork(*cfg);
   ASSERT_TRUE(net.ok()) << net.error().message();
@@ -66,6 +69,48 @@ TEST(NetworkBuilder, AliasAndExplicitDeviceIdReachTheDevice) {
       parseTopology("<Topology>\n<Slave name=\"A\" deviceId=\"70000\"/>\n</Topology>", "t.xml");
   ASSERT_FALSE(wide.ok());
   EXPECT_NE(wide.error().message().find("line 2"), std::string::npos) << wide.error().message();
+}
+
+// An EK1101 (../shared/esi/Beckhoff_EK11xx.xml line 268: Info/IdentificationAdo #x1000, no
+// IdentificationReg134; ConfigData 0401...: a digital I/O PDI, device emulation, no
+// microcontroller) keeps its ID switch where its ESI says a master reads it: at 0x1000, in any
+// state and after a power cycle, and in its input PDO entry "ID" (0x6000:01, TxPDO 0x1A00 of
+// the input SM at 0x1000). It has no firmware to answer in 0x0134. An EK1100 (no ID switch,
+// no IdentificationAdo) given a deviceId is refused: it would show nowhere.
+TEST(NetworkBuilder, AnEk1101ShowsItsIdSwitchAtItsIdentificationAdo) {
+  const auto esi = sharedDir() / "esi" / "Beckhoff_EK11xx.xml";
+  ECSIM_REQUIRE_SHARED(esi);
+  auto topology = [&](const std::string& product) {
+    return parseTopology("<Topology>\n<Slave name=\"EK\" esi=\"" + esi.string() + "\" product=\"" +
+                             product + "\" deviceId=\"7\"/>\n</Topology>",
+                         "t.xml");
+  };
+  auto cfg = topology("#x044d2c52");
+  ASSERT_TRUE(cfg.ok()) << cfg.error().message();
+  auto net = topology::buildNetwork(*cfg);
+  ASSERT_TRUE(net.ok()) << net.error().message();
+  auto& seg = *net->segment;
+  seg.pollSlaves(0);
+  auto id = [&] { return readLe16(one(seg, Command::kAprd, phys(0, 0x1000), {0, 0}).data, 0); };
+  EXPECT_EQ(id(), 7);
+  EXPECT_FALSE(seg.slave(0).profile().explicitDeviceId);
+  const auto* od = slavesim::objectDictionaryOf(seg.slave(0));
+  ASSERT_NE(od, nullptr);
+  const auto* entry = od->findEntry(0x6000, 1);
+  ASSERT_NE(entry, nullptr);
+  EXPECT_EQ(readLe16(entry->value, 0), 7);
+  seg.slave(0).powerOff();
+  seg.slave(0).powerOn(0);
+  EXPECT_EQ(id(), 7) << "after a power cycle";
+
+  auto coupler = topology("#x044c2c52");
+  ASSERT_TRUE(coupler.ok()) << coupler.error().message();
+  auto refused = topology::buildNetwork(*coupler);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().message().find("line 2, slave 'EK': deviceId on a device whose ESC "
+                                           "runs in device emulation"),
+            std::string::npos)
+      << refused.error().message();
 }
 
 TEST(NetworkBuilder, PortBeyondTheEscIsRefused) {
