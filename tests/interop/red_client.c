@@ -12,6 +12,14 @@
  *         "wkc W at cycle C" whenever the working counter changes, and at the end
  *         "done cycles C lost L" (L: cycles whose working counter was not E).
  * exit: 0 after SECONDS of cycles, 2 on bad arguments, 3 when no slave was found.
+ *
+ * A cycle's frames may take RECEIVE_TIMEOUT_US to come back, not SOEM's EC_TIMEOUTRET (2 ms),
+ * as ecmaster's ring runs get 5 ms (soem_redundancy_test.cpp): the test hosts stall server and
+ * client alike for more than 2 ms many times a minute, idle. v2.0.0 keeps to its timeout to the
+ * poll (ppoll at 50 us, oshw/linux/nicdrv.c:505-523) and lost those cycles on a whole ring;
+ * v1.4.0's recv() blocks a whole jiffy (SO_RCVTIMEO of 1 us) before it looks at its timer, and
+ * waited anyway. The wait for the frame SOEM sends again from the second port at a break stays
+ * EC_TIMEOUTRET.
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -33,7 +41,7 @@ static ecx_redportt redport;
 #define WRITESTATE(s) ecx_writestate(&ctx, s)
 #define READSTATE() ecx_readstate(&ctx)
 #define SEND() ecx_send_processdata(&ctx)
-#define RECEIVE() ecx_receive_processdata(&ctx, EC_TIMEOUTRET)
+#define RECEIVE() ecx_receive_processdata(&ctx, RECEIVE_TIMEOUT_US)
 #define CLOSE() ecx_close(&ctx)
 #else
 #include "ethercat.h"
@@ -48,9 +56,11 @@ static ecx_redportt redport;
 #define WRITESTATE(s) ec_writestate(s)
 #define READSTATE() ec_readstate()
 #define SEND() ec_send_processdata()
-#define RECEIVE() ec_receive_processdata(EC_TIMEOUTRET)
+#define RECEIVE() ec_receive_processdata(RECEIVE_TIMEOUT_US)
 #define CLOSE() ec_close()
 #endif
+
+#define RECEIVE_TIMEOUT_US 5000
 
 static char io_map[4096];
 
