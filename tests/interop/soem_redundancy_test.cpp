@@ -210,8 +210,10 @@ TEST_P(SoemRedundantRing, CablePulledMidRingLosesNoCycleForARedundantMaster) {
 // port and its BRD back at the second, having passed every slave (the coupler's port 0 loops
 // it back, ESC datasheet section I §3.2), and sends the frame again from the second port after
 // the cycle's wait (5 ms, above): each cycle of the break is 5 ms late but whole, all but the
-// one at the cut (above). An independent check of the simulator's side of what our master's
-// transport relies on for the same break.
+// one at the cut (above), or instead the one at the heal: the frame sent again from the second
+// port just before it leaves at the first port, open again, unprocessed (WKC 0; capture of
+// 2026-11-30), and nothing comes back where SOEM waits. An independent check of the simulator's
+// side of what our master's transport relies on for the same break.
 TEST_P(SoemRedundantRing, ItsOwnCablePulledLosesNoCycle) {
   expectARunWithoutLostCycles(
       soemClient(GetParam()),
