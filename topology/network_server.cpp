@@ -136,12 +136,14 @@ Status NetworkServer::answer(std::chrono::nanoseconds wait, const std::function<
   const std::uint64_t malformedBefore = segment_.counters().framesMalformed;
   FrameOutcome outcome = segment_.processFrame(frame, now, from);
   if (!outcome.delivered) {
+    if (segment_.counters().framesMalformed == malformedBefore) {
+      ++counters_.framesLost;  // well-formed, and it met a pulled cable or an injected loss
+      return okStatus();
+    }
     ++counters_.framesDropped;
     // A malformed frame is left as it came (the segment refuses it before changing a byte).
-    if (options_.malformedObserver != nullptr &&
-        segment_.counters().framesMalformed != malformedBefore) {
+    if (options_.malformedObserver != nullptr)
       options_.malformedObserver->onFrame(frame, now, true);
-    }
     return okStatus();
   }
   counters_.lastRoundTrip = outcome.returnTime - now;

@@ -45,6 +45,7 @@ struct ServerCounters {
   std::uint64_t framesReceived{0};
   std::uint64_t framesAnswered{0};
   std::uint64_t framesDropped{0};  // malformed: not answered
+  std::uint64_t framesLost{0};     // lost in the network (a pulled cable, an injected loss)
   std::uint64_t framesLate{0};     // paced: modelled return beyond maxPacedWait, not answered
   std::uint64_t receiveErrors{0};
   std::uint64_t sendErrors{0};

@@ -21,6 +21,7 @@ StatusSnapshot sample() {
   snap.framesReceived = 1234;
   snap.framesAnswered = 1230;
   snap.framesDropped = 4;
+  snap.framesLost = 2;
   snap.framesPerSecond = 1000.0;
   snap.lastRoundTrip = 12'340;
   SlaveStatus a;
@@ -59,7 +60,7 @@ TEST(StatusView, TableHasAHeaderAndOneLinePerSlave) {
   ASSERT_EQ(lines.size(), 4u);
   EXPECT_NE(lines[0].find("frames 1234 in / 1230 out (1000/s)"), std::string::npos) << lines[0];
   EXPECT_NE(lines[0].find("last round trip 12.34 us"), std::string::npos) << lines[0];
-  EXPECT_NE(lines[0].find("dropped 4"), std::string::npos);
+  EXPECT_NE(lines[0].find("malformed 4  lost 2"), std::string::npos) << lines[0];
   EXPECT_NE(lines[1].find("dc diff ns"), std::string::npos);
   EXPECT_NE(lines[2].find("OP"), std::string::npos) << lines[2];
   EXPECT_NE(lines[2].find("-17"), std::string::npos) << lines[2];

@@ -41,6 +41,12 @@ TEST(NetworkServer, AnswersAndDropsMalformedFrames) {
   auto none = master.receive(buf, std::chrono::milliseconds(5));
   ASSERT_TRUE(none.ok());
   EXPECT_EQ(*none, 0u) << "a malformed frame is not answered";
+  // A well-formed frame that meets a pulled cable is lost, not malformed.
+  seg.setLinkUp(0, 0, false);
+  ASSERT_TRUE(master.send(ConstBytes(buf.data(), len)).ok());
+  ASSERT_TRUE(server.step().ok());
+  EXPECT_EQ(server.counters().framesDropped, 1u);
+  EXPECT_EQ(server.counters().framesLost, 1u);
 }
 
 TEST(NetworkServer, PacedModeHoldsTheAnswerUntilTheModelledReturnTime) {

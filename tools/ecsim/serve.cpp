@@ -311,9 +311,10 @@ int runServe(ServeOptions o) {
   const auto& sc = segment.counters();
   fmt::print(
       "ecsim: stopped; frames received {}, answered {}, malformed dropped {}, "
-      "late (paced, beyond 1 s) {}, receive errors {}, send errors {}, datagrams {}\n",
-      c.framesReceived, c.framesAnswered, c.framesDropped, c.framesLate, c.receiveErrors,
-      c.sendErrors, sc.datagramsProcessed);
+      "lost in the network {}, late (paced, beyond 1 s) {}, receive errors {}, send errors {}, "
+      "datagrams {}\n",
+      c.framesReceived, c.framesAnswered, c.framesDropped, c.framesLost, c.framesLate,
+      c.receiveErrors, c.sendErrors, sc.datagramsProcessed);
   if (!status.ok()) {
     fmt::print(stderr, "ecsim serve: {}\n", status.error().message());
     return 1;

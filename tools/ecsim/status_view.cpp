@@ -6,10 +6,10 @@
 #include <fstream>
 #include <system_error>
 
+#include "embed/slave_variables.hpp"
 #include "protocol/registers.hpp"
 #include "slavesim/coe/data_types.hpp"
 #include "slavesim/esi_slave.hpp"
-#include "embed/slave_variables.hpp"
 #include "topology/slave_names.hpp"
 
 namespace ecsim::tools {
@@ -79,6 +79,7 @@ StatusSnapshot takeStatusSnapshot(topology::Segment& segment,
   snap.framesReceived = counters.framesReceived;
   snap.framesAnswered = counters.framesAnswered;
   snap.framesDropped = counters.framesDropped;
+  snap.framesLost = counters.framesLost;
   snap.receiveErrors = counters.receiveErrors;
   snap.sendErrors = counters.sendErrors;
   snap.framesPerSecond = framesPerSecond;
@@ -128,11 +129,11 @@ StatusSnapshot takeStatusSnapshot(topology::Segment& segment,
 
 std::string formatStatusTable(const StatusSnapshot& snap) {
   std::string out = fmt::format(
-      "ecsim serve  up {:.1f} s  frames {} in / {} out ({:.0f}/s)  dropped {}  rx errors {}  "
-      "tx errors {}  last round trip {:.2f} us\n",
+      "ecsim serve  up {:.1f} s  frames {} in / {} out ({:.0f}/s)  malformed {}  lost {}  "
+      "rx errors {}  tx errors {}  last round trip {:.2f} us\n",
       static_cast<double>(snap.uptime) / 1e9, snap.framesReceived, snap.framesAnswered,
-      snap.framesPerSecond, snap.framesDropped, snap.receiveErrors, snap.sendErrors,
-      micros(snap.lastRoundTrip));
+      snap.framesPerSecond, snap.framesDropped, snap.framesLost, snap.receiveErrors,
+      snap.sendErrors, micros(snap.lastRoundTrip));
   out += fmt::format("{:>3}  {:<16} {:<10} {:>6}  {:>10} {:>10}  {:>6} {:>5}  {:>12}  {}\n", "pos",
                      "name", "state", "code", "frames", "datagrams", "rxerr", "lost", "dc diff ns",
                      "process data (>out <in)");
@@ -149,10 +150,10 @@ std::string formatStatusJson(const StatusSnapshot& snap) {
   std::string out = "{";
   out += fmt::format(
       "\"uptimeNs\":{},\"framesReceived\":{},\"framesAnswered\":{},\"framesDropped\":{},"
-      "\"receiveErrors\":{},\"sendErrors\":{},\"framesPerSecond\":{:.1f},\"lastRoundTripNs\":{},"
-      "\"slaves\":[",
-      snap.uptime, snap.framesReceived, snap.framesAnswered, snap.framesDropped, snap.receiveErrors,
-      snap.sendErrors, snap.framesPerSecond, snap.lastRoundTrip);
+      "\"framesLost\":{},\"receiveErrors\":{},\"sendErrors\":{},\"framesPerSecond\":{:.1f},"
+      "\"lastRoundTripNs\":{},\"slaves\":[",
+      snap.uptime, snap.framesReceived, snap.framesAnswered, snap.framesDropped, snap.framesLost,
+      snap.receiveErrors, snap.sendErrors, snap.framesPerSecond, snap.lastRoundTrip);
   for (std::size_t i = 0; i < snap.slaves.size(); ++i) {
     const SlaveStatus& s = snap.slaves[i];
     if (i > 0) out += ',';

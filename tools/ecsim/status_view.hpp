@@ -45,6 +45,7 @@ struct StatusSnapshot {
   std::uint64_t framesReceived{0};
   std::uint64_t framesAnswered{0};
   std::uint64_t framesDropped{0};
+  std::uint64_t framesLost{0};
   std::uint64_t receiveErrors{0};
   std::uint64_t sendErrors{0};
   double framesPerSecond{0.0};
