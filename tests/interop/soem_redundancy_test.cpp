@@ -198,12 +198,23 @@ class SoemRedundancy : public ::testing::TestWithParam<std::string> {
 // with 2 ms lost cycles in 31 of 35 (2026-11-30).
 class SoemRedundantRing : public SoemRedundancy {};
 
-TEST_P(SoemRedundantRing, CablePulledMidRingLosesNoCycleForARedundantMaster) {
-  expectARunWithoutLostCycles(soemClient(GetParam()), [](const RingRun& ring) {
-    EXPECT_EQ(ring.exitCode, 0) << ring.master;
-    EXPECT_NE(ring.master.find("slaves 6"), std::string::npos) << ring.master;
-    EXPECT_EQ(ring.cycles, 5000) << ring.master;
-  });
+// One cycle of the break may be lost, with the WKC of the coupler's side (4), as seen in two of
+// three runs of 2026-11-30 ("wkc 4 at cycle 1781", "... 2126"; no cycle numbers of the cut are
+// logged). Two ways lead there, both in SOEM's ecx_waitinframe_red (v1.4.0 and v2.0.0 alike):
+// the cycle on the wire at the cut, whose dummy BRD went round the ring before it and whose LRW
+// met it, so that both come back at the primary port and nothing at the second, a pair the
+// function does not handle (it returns the first frame's WKC); or, during the break, the frame
+// SOEM sends again from the second port kept beyond its fixed EC_TIMEOUTRET by a host stall.
+// Every other cycle of the 2 s break is whole; a ring that did not hold loses about 2000.
+TEST_P(SoemRedundantRing, CablePulledMidRingLosesAtMostTheCycleInFlightAtTheCut) {
+  expectARunWithoutLostCycles(
+      soemClient(GetParam()),
+      [](const RingRun& ring) {
+        EXPECT_EQ(ring.exitCode, 0) << ring.master;
+        EXPECT_NE(ring.master.find("slaves 6"), std::string::npos) << ring.master;
+        EXPECT_EQ(ring.cycles, 5000) << ring.master;
+      },
+      "drives", 1);
 }
 
 // The primary port's own cable pulled: SOEM's ecx_waitinframe_red gets nothing at the primary
