@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "protocol/unique_fd.hpp"
+#include "slavesim/record_text.hpp"
 
 namespace ecsim::slavesim::devices {
 namespace {
@@ -28,15 +29,10 @@ Error refused(const std::filesystem::path& path, const std::string& why) {
                    path.string() + ": " + why + ": refused as a device state file, left as it is");
 }
 
-Error parseError(const std::filesystem::path& path, int line, const std::string& what) {
-  return makeError(ErrorCode::kParse, path.string() + ":" + std::to_string(line) + ": " + what);
-}
-
 // Reads what `path` names into `buffer` without following a link or blocking: nullopt when
 // there is nothing, the number of bytes when it is a regular file of at most
 // kMaxDeviceStateBytes, an error naming the path otherwise.
-Result<std::optional<std::size_t>> readExisting(const std::filesystem::path& path,
-                                                Buffer& buffer) {
+Result<std::optional<std::size_t>> readExisting(const std::filesystem::path& path, Buffer& buffer) {
   struct stat st {};
   if (::lstat(path.c_str(), &st) != 0) {
     if (errno == ENOENT) return std::optional<std::size_t>();
@@ -68,42 +64,26 @@ Result<std::optional<std::size_t>> readExisting(const std::filesystem::path& pat
 
 Result<DeviceState> parse(const std::filesystem::path& path, std::string_view text) {
   DeviceState state;
-  bool header = false;
   bool angle = false;
-  int lineNo = 0;
-  while (!text.empty()) {
-    const std::size_t end = text.find('\n');
-    std::string_view line = text.substr(0, end);
-    text = end == std::string_view::npos ? std::string_view() : text.substr(end + 1);
-    ++lineNo;
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    if (line.empty() || line.front() == '#') continue;
-    const std::size_t space = line.find(' ');
-    const std::string_view key = line.substr(0, space);
-    const std::string_view value =
-        space == std::string_view::npos ? std::string_view() : line.substr(space + 1);
-    if (!header) {
-      if (key != kMagic) return parseError(path, lineNo, "not an ecsim device state file");
-      if (value != kVersion) {
-        return parseError(path, lineNo,
-                          "unsupported device state version '" + std::string(value) + "'");
-      }
-      header = true;
-      continue;
-    }
-    if (key == kShaftAngle) {
-      double v = 0.0;
-      auto [ptr, err] = std::from_chars(value.data(), value.data() + value.size(), v);
-      if (err != std::errc() || ptr != value.data() + value.size() || !std::isfinite(v)) {
-        return parseError(path, lineNo, "bad shaft angle '" + std::string(value) + "'");
-      }
-      state.shaftAngle = v;
-      angle = true;
-    }
-    // Unknown keys are skipped: later versions of a version-1 file may add some.
-  }
-  if (!header) return parseError(path, lineNo, "empty device state file");
-  if (!angle) return parseError(path, lineNo, "no " + std::string(kShaftAngle) + " line");
+  const RecordFormat format{kMagic, kVersion, "device state file"};
+  ECSIM_ASSIGN_OR_RETURN(
+      const int lines,
+      readRecord(path.string(), text, format,
+                 [&](int lineNo, std::string_view key, std::string_view value) -> Status {
+                   // Unknown keys are skipped: later versions of a version-1 file may add some.
+                   if (key != kShaftAngle) return okStatus();
+                   double v = 0.0;
+                   auto [ptr, err] = std::from_chars(value.data(), value.data() + value.size(), v);
+                   if (err != std::errc() || ptr != value.data() + value.size() ||
+                       !std::isfinite(v)) {
+                     return recordError(path.string(), lineNo,
+                                        "bad shaft angle '" + std::string(value) + "'");
+                   }
+                   state.shaftAngle = v;
+                   angle = true;
+                   return okStatus();
+                 }));
+  if (!angle) return recordError(path.string(), lines, "no " + std::string(kShaftAngle) + " line");
   return state;
 }
 
@@ -166,8 +146,7 @@ Status DeviceStateFile::save(const DeviceState& state) const {
       "# ecsim device state: the drive's shaft angle, kept across power cycles\n%.*s %.*s\n"
       "%.*s %.17g\n",
       static_cast<int>(kMagic.size()), kMagic.data(), static_cast<int>(kVersion.size()),
-      kVersion.data(), static_cast<int>(kShaftAngle.size()), kShaftAngle.data(),
-      state.shaftAngle);
+      kVersion.data(), static_cast<int>(kShaftAngle.size()), kShaftAngle.data(), state.shaftAngle);
   if (length < 0 || static_cast<std::size_t>(length) >= buffer.size()) {
     return makeError(ErrorCode::kTooLarge, path_.string() + ": device state too long");
   }

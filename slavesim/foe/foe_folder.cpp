@@ -1,5 +1,7 @@
 #include "slavesim/foe/foe_folder.hpp"
 
+#include "slavesim/record_text.hpp"
+
 #include <dirent.h>
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -68,51 +70,30 @@ Status readRegular(const std::string& path, std::size_t limit, FoeFile& file) {
   }
 }
 
-Error parseError(const std::string& path, int line, const std::string& what) {
-  return makeError(ErrorCode::kParse, path + ":" + std::to_string(line) + ": " + what);
-}
-
 Status parseRecord(const std::string& path, std::string_view text, FoeFolderContent& content) {
-  bool header = false;
-  int lineNo = 0;
-  while (!text.empty()) {
-    const std::size_t end = text.find('\n');
-    std::string_view line = text.substr(0, end);
-    text = end == std::string_view::npos ? std::string_view() : text.substr(end + 1);
-    ++lineNo;
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    if (line.empty() || line.front() == '#') continue;
-    const std::size_t space = line.find(' ');
-    const std::string_view key = line.substr(0, space);
-    const std::string_view value =
-        space == std::string_view::npos ? std::string_view() : line.substr(space + 1);
-    if (!header) {
-      if (key != kMagic) return parseError(path, lineNo, "not an ecsim FoE firmware record");
-      if (value != kVersion) {
-        return parseError(path, lineNo, "unsupported version '" + std::string(value) + "'");
-      }
-      header = true;
-      continue;
-    }
-    std::optional<std::string>* field = key == kPending     ? &content.pending
-                                        : key == kInstalled ? &content.installedVersion
-                                                            : nullptr;
-    if (field == nullptr) {
-      return parseError(
-          path, lineNo,
-          "unknown key '" + std::string(key) + "' (known: pending, installed-version)");
-    }
-    auto decoded = percentDecode(value);
-    if (!decoded || decoded->empty()) {
-      return parseError(path, lineNo, "bad value '" + std::string(value) + "'");
-    }
-    *field = std::move(*decoded);
-  }
-  if (!header) return parseError(path, lineNo, "empty firmware record");
+  const RecordFormat format{kMagic, kVersion, "FoE firmware record"};
+  auto read = readRecord(
+      path, text, format, [&](int lineNo, std::string_view key, std::string_view value) -> Status {
+        std::optional<std::string>* field = key == kPending     ? &content.pending
+                                            : key == kInstalled ? &content.installedVersion
+                                                                : nullptr;
+        if (field == nullptr) {
+          return recordError(
+              path, lineNo,
+              "unknown key '" + std::string(key) + "' (known: pending, installed-version)");
+        }
+        auto decoded = percentDecode(value);
+        if (!decoded || decoded->empty()) {
+          return recordError(path, lineNo, "bad value '" + std::string(value) + "'");
+        }
+        *field = std::move(*decoded);
+        return okStatus();
+      });
+  if (!read.ok()) return read.takeError();
   return okStatus();
 }
 
-Status readRecord(const std::string& path, FoeFolderContent& content) {
+Status readFirmwareRecord(const std::string& path, FoeFolderContent& content) {
   FoeFile file;
   ECSIM_TRY(readRegular(path, kMaxRecordBytes, file));
   const std::vector<std::uint8_t> bytes = file.bytes();
@@ -200,7 +181,7 @@ Result<FoeFolder> FoeFolder::open(const std::filesystem::path& path, FoeFolderCo
       continue;  // an interrupted transfer or record save: not a file of the device
     }
     if (name == kRecordName) {
-      ECSIM_TRY(readRecord(entry, content));
+      ECSIM_TRY(readFirmwareRecord(entry, content));
       continue;
     }
     std::optional<std::string> decoded;
