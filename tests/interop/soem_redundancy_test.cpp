@@ -198,13 +198,14 @@ class SoemRedundancy : public ::testing::TestWithParam<std::string> {
 // with 2 ms lost cycles in 31 of 35 (2026-11-30).
 class SoemRedundantRing : public SoemRedundancy {};
 
-// One cycle of the break may be lost, with the WKC of the coupler's side (4), as seen in two of
-// three runs of 2026-11-30 ("wkc 4 at cycle 1781", "... 2126"; no cycle numbers of the cut are
-// logged). Two ways lead there, both in SOEM's ecx_waitinframe_red (v1.4.0 and v2.0.0 alike):
-// the cycle on the wire at the cut, whose dummy BRD went round the ring before it and whose LRW
-// met it, so that both come back at the primary port and nothing at the second, a pair the
-// function does not handle (it returns the first frame's WKC); or, during the break, the frame
-// SOEM sends again from the second port kept beyond its fixed EC_TIMEOUTRET by a host stall.
+// One cycle of the break may be lost, in two ways, both in SOEM's ecx_waitinframe_red (v1.4.0
+// and v2.0.0 alike). At the cut: a cycle whose LRW went round the whole ring just before it
+// and came back at the second port, and whose dummy BRD, sent from there just after, came
+// back there too, leaves nothing at the first port, a pair the function has no answer for
+// ("wkc -1 at cycle 1929" in capture run z2 of 2026-11-30). During the break: the frame SOEM
+// sends again from the second port must be back within its fixed EC_TIMEOUTRET (2 ms), which
+// the client cannot change; 2 of that run's 2085 came back after 2.24 and 2.56 ms (median 80
+// us, the host busy with a build) and those cycles kept the WKC of the coupler's side ("wkc 4").
 // Every other cycle of the 2 s break is whole; a ring that did not hold loses about 2000.
 TEST_P(SoemRedundantRing, CablePulledMidRingLosesAtMostTheCycleInFlightAtTheCut) {
   expectARunWithoutLostCycles(
