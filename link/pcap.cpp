@@ -27,18 +27,6 @@ constexpr std::size_t kPcapRecordHeaderSize = 16;
 constexpr std::size_t kWriteBufferSize = 128 * 1024;
 static_assert(kWriteBufferSize >= kPcapRecordHeaderSize + kPcapSnapLength);
 
-// Writes all of `data`; errno text on failure.
-Status writeAll(int fd, ConstBytes data, const std::string& what) {
-  std::size_t done = 0;
-  while (done < data.size()) {
-    const ssize_t n = ::write(fd, data.data() + done, data.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return makeError(ErrorCode::kIo, what + ": " + errnoText(n < 0 ? errno : EIO));
-    done += static_cast<std::size_t>(n);
-  }
-  return okStatus();
-}
-
 }  // namespace
 
 struct PcapWriter::Impl {

@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstring>
 
 namespace ecsim {
@@ -24,6 +25,19 @@ const char* fileKindText(mode_t mode) {
   if (S_ISSOCK(mode)) return "a socket";
   if (S_ISLNK(mode)) return "a symbolic link";
   return "not a regular file";
+}
+
+Status writeAll(int fd, ConstBytes data, const std::string& shown) {
+  std::size_t done = 0;
+  while (done < data.size()) {
+    const ssize_t n = ::write(fd, data.data() + done, data.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      return makeError(ErrorCode::kIo, shown + ": write failed: " + errnoText(n < 0 ? errno : EIO));
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  return okStatus();
 }
 
 }  // namespace ecsim

@@ -1,11 +1,14 @@
-// POSIX file helpers every library may use: an owning file descriptor, errno text and what
-// kind of file a mode names. (link/fd.hpp adds the bounded wait the links need.)
+// POSIX file helpers every library may use: an owning file descriptor, errno text, what
+// kind of file a mode names, and a whole write. (link/fd.hpp adds the bounded wait the links need.)
 #pragma once
 
 #include <sys/types.h>
 
 #include <string>
 #include <utility>
+
+#include "protocol/bytes.hpp"
+#include "protocol/result.hpp"
 
 namespace ecsim {
 
@@ -42,5 +45,9 @@ std::string errnoText(int err);
 // "a character device", "a block device", "a socket", "a symbolic link", else
 // "not a regular file".
 const char* fileKindText(mode_t mode);
+
+// Writes all of `data` to `fd`: write(2) until done, EINTR retried. On failure a kIo error
+// "SHOWN: write failed: <errno text>", SHOWN naming the file (and what was being written).
+Status writeAll(int fd, ConstBytes data, const std::string& shown);
 
 }  // namespace ecsim

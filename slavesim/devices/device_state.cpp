@@ -103,17 +103,6 @@ Result<int> createTemporary(const std::string& tmp) {
   return makeError(ErrorCode::kIo, tmp + ": keeps coming back");
 }
 
-Status writeAll(int fd, const char* data, std::size_t size, const std::string& shown) {
-  while (size > 0) {
-    const ssize_t n = ::write(fd, data, size);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) return makeError(ErrorCode::kIo, shown + ": write failed: " + errnoText(errno));
-    data += n;
-    size -= static_cast<std::size_t>(n);
-  }
-  return okStatus();
-}
-
 }  // namespace
 
 Result<DeviceStateFile> DeviceStateFile::open(const std::filesystem::path& path) {
@@ -153,7 +142,10 @@ Status DeviceStateFile::save(const DeviceState& state) const {
   {
     ECSIM_ASSIGN_OR_RETURN(int raw, createTemporary(tmp_));
     UniqueFd fd(raw);
-    ECSIM_TRY(writeAll(fd.get(), buffer.data(), static_cast<std::size_t>(length), tmp_));
+    ECSIM_TRY(writeAll(fd.get(),
+                       ConstBytes(reinterpret_cast<const std::uint8_t*>(buffer.data()),
+                                  static_cast<std::size_t>(length)),
+                       tmp_));
     if (::fsync(fd.get()) != 0) {
       return makeError(ErrorCode::kIo, tmp_ + ": fsync failed: " + errnoText(errno));
     }

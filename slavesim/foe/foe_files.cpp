@@ -1,9 +1,9 @@
 #include "slavesim/foe/foe_files.hpp"
 
-#include "slavesim/foe/foe_folder.hpp"
-
 #include <algorithm>
 #include <array>
+
+#include "slavesim/foe/foe_folder.hpp"
 
 namespace ecsim::slavesim::foe {
 

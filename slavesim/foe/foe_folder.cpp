@@ -101,17 +101,6 @@ Status readFirmwareRecord(const std::string& path, FoeFolderContent& content) {
       path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()), content);
 }
 
-Status writeAll(int fd, const std::uint8_t* data, std::size_t size, const std::string& shown) {
-  while (size > 0) {
-    const ssize_t n = ::write(fd, data, size);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) return ioError(shown, "write failed: ", errno);
-    data += n;
-    size -= static_cast<std::size_t>(n);
-  }
-  return okStatus();
-}
-
 }  // namespace
 
 std::filesystem::path foeFolderFor(const std::filesystem::path& stateFile) {
@@ -214,7 +203,7 @@ Status FoeFolder::begin(const std::string& name) {
 
 Status FoeFolder::append(ConstBytes bytes) {
   if (!writing_.valid()) return makeError(ErrorCode::kInvalidArgument, "no FoE file being written");
-  return writeAll(writing_.get(), bytes.data(), bytes.size(), writingPath_);
+  return writeAll(writing_.get(), bytes, writingPath_);
 }
 
 Status FoeFolder::finish() {
@@ -252,8 +241,9 @@ Status FoeFolder::saveFirmwareRecord(const std::optional<std::string>& pending,
   {
     UniqueFd fd(::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0644));
     if (!fd.valid()) return ioError(tmp, "", errno);
-    ECSIM_TRY(
-        writeAll(fd.get(), reinterpret_cast<const std::uint8_t*>(text.data()), text.size(), tmp));
+    ECSIM_TRY(writeAll(fd.get(),
+                       ConstBytes(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()),
+                       tmp));
     if (::close(fd.release()) != 0) return ioError(tmp, "close failed: ", errno);
   }
   if (::rename(tmp.c_str(), record.c_str()) != 0) {
