@@ -35,6 +35,7 @@ void Esc::reset() {
   sync_ = {};
   activeFmmuCount_ = 0;
   smRangeCount_ = 0;
+  smLowestStart_ = 0xFFFF;
   smTriggerOnlyCount_ = 0;
   smCache_ = {};  // all zero: no SM enabled (rebuildSmCache's view of the zeroed registers)
   smEventControl_ = 0;
@@ -182,7 +183,7 @@ bool Esc::readMemory(std::uint32_t address, Bytes out, bool orInto) {
     // put their output SM at 0x0F00): split the access at SM boundaries first.
     auto a16 = static_cast<std::uint16_t>(at);
     std::uint32_t limit = std::min(address + size, memEnd);
-    const int smIndex = smRangeCount_ == 0 ? -1 : smLookup(at, limit);
+    const int smIndex = smRangeCount_ == 0 || limit <= smLowestStart_ ? -1 : smLookup(at, limit);
     if (smIndex < 0 && at >= kRamStart && !orInto) {  // plain process RAM (most FMMU reads)
       std::copy_n(memory_.begin() + at, limit - at, piece.begin());
       any = true;
@@ -221,7 +222,7 @@ bool Esc::writeMemory(std::uint32_t address, ConstBytes data) {
     }
     auto a16 = static_cast<std::uint16_t>(at);
     std::uint32_t limit = std::min(address + size, memEnd);
-    const int smIndex = smRangeCount_ == 0 ? -1 : smLookup(at, limit);
+    const int smIndex = smRangeCount_ == 0 || limit <= smLowestStart_ ? -1 : smLookup(at, limit);
     if (smIndex < 0 && at >= kRamStart) {  // plain process RAM (most FMMU writes)
       std::copy_n(piece.begin(), limit - at, memory_.begin() + at);
       any = true;
@@ -247,19 +248,18 @@ bool Esc::implemented(std::uint32_t at, std::uint32_t n) const {
   // Registers of FMMU and SM channels beyond what the ESC has, and of a DC unit it lacks, do
   // not exist: an access that touches only those gets no working-counter increment (seen on
   // real ET1200 terminals and an EK1100, docs/fidelity.md). Everything else answers.
+  // type_ is read only for FMMU and SM registers: it lies outside the hot group.
   const std::uint32_t end = at + n;
-  const std::uint32_t fmmuEnd =
-      reg::kFmmuBase + reg::kFmmuSize * static_cast<std::uint32_t>(type_.fmmus);
-  const std::uint32_t smEnd =
-      reg::kSmBase + reg::kSmSize * static_cast<std::uint32_t>(type_.syncManagers);
   constexpr std::uint32_t kDcBegin = reg::kReceiveTimePort0.address;
   constexpr std::uint32_t kDcEnd = 0x0A00;
   constexpr std::uint32_t kDelayOnlyEnd = reg::kReceiveTimePort3.end();
   for (std::uint32_t a = at; a < end; ++a) {
     if (a >= reg::kFmmuBase && a < reg::kFmmuBase + reg::kFmmuSize * reg::kMaxFmmus) {
-      if (a < fmmuEnd) return true;
+      if (a < reg::kFmmuBase + reg::kFmmuSize * static_cast<std::uint32_t>(type_.fmmus))
+        return true;
     } else if (a >= reg::kSmBase && a < reg::kSmBase + reg::kSmSize * reg::kMaxSyncManagers) {
-      if (a < smEnd) return true;
+      if (a < reg::kSmBase + reg::kSmSize * static_cast<std::uint32_t>(type_.syncManagers))
+        return true;
     } else if (a >= kDcBegin && a < kDcEnd) {
       if (dcUnit_ == DcUnit::kFull || (dcUnit_ == DcUnit::kDelayOnly && a < kDelayOnlyEnd))
         return true;

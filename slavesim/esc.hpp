@@ -91,10 +91,18 @@ class Esc {
   // A configured-address datagram (FPRD/FPWR/FPRW) with this ADP is addressed to this ESC: its
   // station address, or its alias while DL control enables it (0x0103 bit 0). Anything else
   // such a datagram meets here is only its header passing (headerIrq()).
-  // Asks the cache for the per-frame state (the first two lines of the hot group below).
+  // Asks the cache for the per-frame state (the hot group below, up to the memory's address).
+  // A network calls it for the ESCs some way down the route, then prefetchMemory() for those
+  // nearer, so that a long line's ESCs, evicted between frames, are fetched together and not
+  // one miss after the other.
   void prefetchFrameState() const {
-    __builtin_prefetch(&dc_);
-    __builtin_prefetch(reinterpret_cast<const char*>(&dc_) + 64);
+    const auto* hot = reinterpret_cast<const char*>(&dc_);
+    for (std::size_t at = 0; at < kHotBytes; at += 64) __builtin_prefetch(hot + at);
+  }
+  // The register or RAM line at `address` (a physical datagram's ADO). Reads the memory's
+  // address, in the hot group: call it once prefetchFrameState() had time to bring that in.
+  void prefetchMemory(std::uint32_t address) const {
+    if (address < memory_.size()) __builtin_prefetch(memory_.data() + address);
   }
   // Read from copies kept beside the per-frame state (refreshAddressing()), so that a frame
   // passing ESCs it does not address touches none of their memory.
@@ -326,9 +334,11 @@ class Esc {
   // ---- What every passing frame touches, first and together (docs/timing.md, "Simulator
   // speed"): a frame passing a thousand ESCs finds them outside the L1 cache, so each ESC costs
   // the cache lines it touches. Line 0: the local clock and the per-datagram flags; line 1: the
-  // datagram's times, per-frame SM state, cache counts, frame counter; line 2: the memory;
-  // then the FMMU cache. A datagram no FMMU of this ESC maps (most of them, in a long line)
-  // touches lines 0, 1 and 3 only. Keep new per-frame state here, cold state further down.
+  // datagram's times, per-frame SM state, cache counts, frame counter; line 2: the other
+  // counters and where the memory is; then the FMMU cache. A datagram no FMMU of this ESC maps
+  // (most of them, in a long line) touches lines 0-2 and the memory it addresses (a register
+  // read below every SyncManager: one line). Keep new per-frame state here, cold state further
+  // down, and kHotBytes covering it.
   alignas(64) DcClock dc_;
   std::uint16_t lastWkcIncrement_{0};
   std::uint16_t ecatIrq_{0};      // 0x0210 & 0x0200
@@ -338,6 +348,9 @@ class Esc {
   std::uint16_t station_{0};
   std::uint16_t alias_{0};
   bool aliasOn_{false};
+  // No enabled SyncManager range starts below this (0xFFFF: none): a register access below
+  // it needs no SM lookup (smRanges_ lies outside the hot group).
+  std::uint16_t smLowestStart_{0xFFFF};
   void refreshAddressing() {
     const std::uint16_t station = reg16(reg::kConfiguredStationAddress.address);
     const std::uint16_t alias = reg16(reg::kConfiguredStationAlias.address);
@@ -377,9 +390,11 @@ class Esc {
   std::uint8_t smRangeCount_{0};
   std::uint8_t smTriggerOnlyCount_{0};
   DcUnit dcUnit_{DcUnit::kFull};
-  EscCounters counters_{};                        // framesSeen first: on line 1
-  alignas(64) std::vector<std::uint8_t> memory_;  // registers 0x0000-0x0FFF + process RAM
+  EscCounters counters_{};            // framesSeen first: on line 1
+  std::vector<std::uint8_t> memory_;  // registers 0x0000-0x0FFF + process RAM
   const RegisterBytes& regs_;  // the register table, per byte (shared by all ESCs)
+  // Bytes of the hot group, from dc_ to regs_ (prefetchFrameState()).
+  static constexpr std::size_t kHotBytes = 192;
   struct ActiveFmmu {
     std::uint64_t logicalStartBit;  // absolute logical bit address
     std::uint64_t logicalEndBit;    // inclusive

@@ -25,6 +25,7 @@ void Esc::rebuildSmCache() {
   std::uint32_t wasBuffer = 0;
   for (std::uint8_t k = 0; k < smRangeCount_; ++k) wasBuffer |= 1u << smRanges_[k].index;
   smRangeCount_ = 0;
+  smLowestStart_ = 0xFFFF;
   smTriggerOnlyCount_ = 0;
   smEventControl_ = 0;
   for (unsigned s = 0; s < type_.syncManagers; ++s) {
@@ -40,6 +41,7 @@ void Esc::rebuildSmCache() {
     }
     smRanges_[smRangeCount_++] = {c.start, static_cast<std::uint32_t>(c.start) + c.length,
                                   static_cast<std::uint8_t>(s)};
+    smLowestStart_ = std::min(smLowestStart_, c.start);
     if ((wasBuffer & (1u << s)) == 0 && !isMailbox(c.control)) {
       // Freshly activated 3-buffer SM: status bits 5:4 "last written buffer" = 11, no buffer
       // written yet (section II, SyncManager status register 0x0805+8n).

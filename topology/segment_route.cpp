@@ -28,6 +28,9 @@ Reach reach(const DatagramView& d) {
   }
 }
 
+// How many ESCs ahead of the one processing the frame the next ones' state is asked for.
+constexpr std::size_t kPrefetch = 8;
+
 // The route position an auto-increment datagram sent with `adp` acts at.
 std::uint32_t positionOf(std::uint16_t adp) {
   return static_cast<std::uint16_t>(0x10000u - adp);
@@ -49,13 +52,35 @@ void Segment::passRoute(std::size_t count, const std::array<SimTime, 128>& leads
     passRouteIndexed(count, leads, sendTime);
     return;
   }
-  for (const RouteStop& stop : route_) {
+  auto visit = [&](const RouteStop& stop) {
     slavesim::Esc& esc = *escs_[stop.slave];
     esc.beginFrame();
     const SimTime t = sendTime + stop.at;
     for (std::size_t i = 0; i < count; ++i) esc.processDatagram(datagrams_[i], t + leads[i]);
     if (esc.receiveTimeLatchArmed()) latched_.push_back(stop.slave);
+  };
+  // A long line's ESCs do not stay in the cache between frames: the state of those further
+  // down the route is asked for while this one works, in two steps (the per-frame state, then
+  // the memory the frame's first physical datagram addresses, found through that state). A
+  // short line gains nothing from it.
+  const std::size_t stops = route_.size();
+  std::size_t k = 0;
+  if (stops > 2 * kPrefetch) {
+    std::uint32_t address = 0;
+    bool physical = false;
+    for (std::size_t i = 0; i < count && !physical; ++i) {
+      if (!isKnownCommand(datagrams_[i].rawCommand())) continue;
+      const AddressMode mode = addressMode(datagrams_[i].command());
+      physical = mode != AddressMode::kLogical && mode != AddressMode::kNone;
+      address = datagrams_[i].ado();
+    }
+    for (; k + 2 * kPrefetch < stops; ++k) {
+      escs_[route_[k + 2 * kPrefetch].slave]->prefetchFrameState();
+      if (physical) escs_[route_[k + kPrefetch].slave]->prefetchMemory(address);
+      visit(route_[k]);
+    }
   }
+  for (; k < stops; ++k) visit(route_[k]);
 }
 
 void Segment::passRouteIndexed(std::size_t count, const std::array<SimTime, 128>& leads,
@@ -97,7 +122,6 @@ void Segment::passRouteIndexed(std::size_t count, const std::array<SimTime, 128>
   constexpr std::size_t kNone = 128;
   // The ESCs further down the route are brought into the cache while this one works (a long
   // line's ESCs do not stay in the cache between frames).
-  constexpr std::size_t kPrefetch = 8;
   const std::size_t stops = route_.size();
   for (std::size_t k = 0; k < stops; ++k) {
     const RouteStop& stop = route_[k];
