@@ -145,16 +145,10 @@ std::optional<std::string> percentDecode(std::string_view text) {
 Result<FoeFolder> FoeFolder::open(const std::filesystem::path& path, FoeFolderContent& content,
                                   std::size_t maxFileBytes) {
   const std::string shown = path.string();
-  struct stat st {};
-  if (::lstat(path.c_str(), &st) != 0) {
-    if (errno != ENOENT) return ioError(shown, "", errno);
-    if (::mkdir(path.c_str(), 0755) != 0)
-      return ioError(shown, "cannot create the folder: ", errno);
-  } else if (S_ISLNK(st.st_mode)) {
-    return refused(shown, "a symbolic link (name the folder itself)");
-  } else if (!S_ISDIR(st.st_mode)) {
-    return refused(shown, fileKindText(st.st_mode));
-  }
+  FoeFolder folder;
+  folder.path_ = path;
+  ECSIM_ASSIGN_OR_RETURN(const bool exists, folder.check());
+  if (!exists) return folder;  // made with the first file or record written
   std::unique_ptr<DIR, int (*)(DIR*)> dir(::opendir(path.c_str()), &::closedir);
   if (!dir) return ioError(shown, "", errno);
   std::vector<std::string> names;
@@ -182,13 +176,32 @@ Result<FoeFolder> FoeFolder::open(const std::filesystem::path& path, FoeFolderCo
     ECSIM_TRY(readRegular(entry, maxFileBytes, file));
     content.files.emplace_back(std::move(*decoded), std::move(file));
   }
-  FoeFolder folder;
-  folder.path_ = path;
   return folder;
+}
+
+Result<bool> FoeFolder::check() const {
+  const std::string shown = path_.string();
+  struct stat st {};
+  if (::lstat(path_.c_str(), &st) != 0) {
+    if (errno != ENOENT) return ioError(shown, "", errno);
+    return false;
+  }
+  if (S_ISLNK(st.st_mode)) return refused(shown, "a symbolic link (name the folder itself)");
+  if (!S_ISDIR(st.st_mode)) return refused(shown, fileKindText(st.st_mode));
+  return true;
+}
+
+Status FoeFolder::create() const {
+  ECSIM_ASSIGN_OR_RETURN(const bool exists, check());
+  if (!exists && ::mkdir(path_.c_str(), 0755) != 0 && errno != EEXIST) {
+    return ioError(path_.string(), "cannot create the folder: ", errno);
+  }
+  return okStatus();
 }
 
 Status FoeFolder::begin(const std::string& name) {
   abandon();
+  ECSIM_TRY(create());
   finalPath_ = (path_ / (std::string(kFilePrefix) + percentEncode(name))).string();
   writingPath_ = finalPath_ + std::string(kTmpSuffix);
   writing_ = UniqueFd(
@@ -236,6 +249,7 @@ Status FoeFolder::saveFirmwareRecord(const std::optional<std::string>& pending,
   if (pending) text += std::string(kPending) + " " + percentEncode(*pending) + "\n";
   if (installedVersion)
     text += std::string(kInstalled) + " " + percentEncode(*installedVersion) + "\n";
+  ECSIM_TRY(create());
   const std::string record = (path_ / kRecordName).string();
   const std::string tmp = record + std::string(kTmpSuffix);
   {

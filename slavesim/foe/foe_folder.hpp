@@ -54,8 +54,9 @@ struct FoeFolderContent {
 
 class FoeFolder {
  public:
-  // Opens `path` (created when missing; its parent must exist) and reads what it holds into
-  // `content`; files over `maxFileBytes` are refused.
+  // Opens `path` and reads what it holds into `content`; files over `maxFileBytes` are
+  // refused. A missing folder holds nothing: it is made (its parent must exist) when the first
+  // file or record is written, so building a network that is never run leaves no trace.
   static Result<FoeFolder> open(const std::filesystem::path& path, FoeFolderContent& content,
                                 std::size_t maxFileBytes);
 
@@ -73,6 +74,10 @@ class FoeFolder {
                             const std::optional<std::string>& installedVersion) const;
 
  private:
+  // true: the folder is there; false: missing; an error for anything else at its path.
+  Result<bool> check() const;
+  // Makes the folder when missing.
+  Status create() const;
   std::filesystem::path path_;
   UniqueFd writing_;
   std::string writingPath_;  // file-NAME.tmp of the file being written

@@ -132,13 +132,25 @@ TEST_F(FoeFolderTest, ATransferCutShortLeavesThePreviousFile) {
   EXPECT_EQ(again.read("app.bin"), first);
 }
 
+TEST_F(FoeFolderTest, NothingIsMadeUntilAFileIsWritten) {
+  ECSIM_REQUIRE_SHARED(sharedDir() / "esi" / "SOES_lan9252demo_slave.xml");
+  FoeSlave s(options());
+  ASSERT_TRUE(s.ready());
+  // A network built by a command that never runs it (ecsim check, a study) leaves no folder.
+  EXPECT_FALSE(std::filesystem::exists(folder()));
+  s.toBoot();
+  EXPECT_FALSE(std::filesystem::exists(folder())) << "a state change writes nothing";
+  EXPECT_EQ(s.write("app.bin", firmwareImage(200, "x")).value, 2u);
+  EXPECT_TRUE(std::filesystem::is_regular_file(folder() / "file-app.bin"));
+}
+
 TEST_F(FoeFolderTest, AFileTheHostCannotWriteIsDiskFull) {
   ECSIM_REQUIRE_SHARED(sharedDir() / "esi" / "SOES_lan9252demo_slave.xml");
   FoeSlave s(options());
   ASSERT_TRUE(s.ready());
   s.toBoot();
   // A folder where the transfer's temporary file would go: open(2) fails (EISDIR).
-  std::filesystem::create_directory(folder() / "file-app.bin.tmp");
+  std::filesystem::create_directories(folder() / "file-app.bin.tmp");
   const FoeReply w = s.transact(FoeOpcode::kWrite, 0, std::string_view("app.bin"));
   EXPECT_EQ(w.opcode, FoeOpcode::kError);
   EXPECT_EQ(w.value, 0x8003u) << "disk full";
