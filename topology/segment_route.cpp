@@ -42,10 +42,16 @@ void Segment::passRoute(std::size_t count, const std::array<SimTime, 128>& leads
                         SimTime sendTime) {
   bool addressedOnly = false;
   bool everywhere = false;
+  bool physical = false;      // the frame has a physical (not logical) datagram,
+  std::uint32_t address = 0;  // and this is the first one's ADO (fetched ahead below)
   for (std::size_t i = 0; i < count; ++i) {
     const Reach r = reach(datagrams_[i]);
     addressedOnly = addressedOnly || r == Reach::kAddressed;
     everywhere = everywhere || r == Reach::kEverywhere;
+    if (!physical && r != Reach::kHeaderOnly && !isLogical(datagrams_[i].command())) {
+      physical = true;
+      address = datagrams_[i].ado();
+    }
   }
   if (indexedPasses_ && !everywhere && passRouteAddressed(count, leads, sendTime)) return;
   if (addressedOnly) {
@@ -66,14 +72,6 @@ void Segment::passRoute(std::size_t count, const std::array<SimTime, 128>& leads
   const std::size_t stops = route_.size();
   std::size_t k = 0;
   if (stops > 2 * kPrefetch) {
-    std::uint32_t address = 0;
-    bool physical = false;
-    for (std::size_t i = 0; i < count && !physical; ++i) {
-      if (!isKnownCommand(datagrams_[i].rawCommand())) continue;
-      const AddressMode mode = addressMode(datagrams_[i].command());
-      physical = mode != AddressMode::kLogical && mode != AddressMode::kNone;
-      address = datagrams_[i].ado();
-    }
     for (; k + 2 * kPrefetch < stops; ++k) {
       escs_[route_[k + 2 * kPrefetch].slave]->prefetchFrameState();
       if (physical) escs_[route_[k + kPrefetch].slave]->prefetchMemory(address);
