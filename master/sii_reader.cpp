@@ -84,6 +84,15 @@ void SiiReader::fail(Status status) {
   wakeAt_.reset();
 }
 
+bool SiiReader::sendAgainIfLost(const Status& status, SimTime now) {
+  if (status.error().code != ErrorCode::kTimeout || now - commandAt_ > options_.busyTimeout) {
+    return false;
+  }
+  ++framesSentAgain_;
+  transport_.queue(datagram_);  // its bytes are as built: a lost frame changed nothing here
+  return true;
+}
+
 bool SiiReader::step(SimTime now) {
   switch (state_) {
     case State::kIdle:
@@ -94,6 +103,7 @@ bool SiiReader::step(SimTime now) {
     case State::kClearError: {
       if (datagram_.pending()) return true;
       if (auto s = datagram_.check(); !s.ok()) {
+        if (sendAgainIfLost(s, now)) return true;
         fail(makeError(s.error().code, "SII read of word " + hex4(current_) + " at station " +
                                            hex4(station_) + ": " + s.error().context));
         return false;
@@ -123,6 +133,7 @@ bool SiiReader::step(SimTime now) {
       }
       if (datagram_.pending()) return true;
       if (auto s = datagram_.check(); !s.ok()) {
+        if (sendAgainIfLost(s, now)) return true;
         fail(makeError(s.error().code,
                        "SII status of station " + hex4(station_) + ": " + s.error().context));
         return false;

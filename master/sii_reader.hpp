@@ -8,6 +8,13 @@
 //     busy (0x0502 bit 15)       wait busyPollInterval, read again, up to `busyTimeout`
 //     error bits (0x7800)        clear them with a NOP command and retry, `retries` times
 //
+// A frame of this handshake that the transport gave up (every try unanswered: a stall of the
+// host, a disturbed wire) is sent again while the word's read is within `busyTimeout` of its
+// command, as SOEM reads the status again until EC_TIMEOUTEEP whatever became of the last
+// frame (ecx_eeprom_waitnotbusyFP: "wkc <= 0 || busy") and sends the command up to
+// EC_DEFAULTRETRIES + 1 times (ecx_readeepromFP, v1.4.0 ethercatmain.c). A wrong working
+// counter is an answer, not a loss: it fails the read at once.
+//
 // 0x0502 bit 6 tells whether a read yields 4 bytes (2 words) or 8 (4 words). The reader takes
 // the fixed header (words 0x00-0x3F), then walks the category list (type, length, data) up to
 // the END category, bounded by the EEPROM size the header states (at most kMaxBytes).
@@ -56,6 +63,8 @@ class SiiReader final : public Task {
   const std::vector<std::uint8_t>& image() const { return image_; }
   std::vector<std::uint8_t> takeImage() { return std::move(image_); }
   std::uint64_t reads() const { return reads_; }
+  // Frames of the handshake sent again after the transport had given them up.
+  std::uint64_t framesSentAgain() const { return framesSentAgain_; }
 
  private:
   enum class State { kIdle, kCommand, kStatus, kClearError, kDone, kFailed };
@@ -65,6 +74,9 @@ class SiiReader final : public Task {
   std::uint16_t word(std::size_t w) const;
   void issueRead(SimTime now, std::size_t word);
   void fail(Status status);
+  // Queues the datagram again when `status` says its frame was lost and the read is young
+  // enough (see above); false: the caller fails the read.
+  bool sendAgainIfLost(const Status& status, SimTime now);
 
   Transport& transport_;
   std::uint16_t station_;
@@ -80,6 +92,7 @@ class SiiReader final : public Task {
   SimTime commandAt_{0};
   std::optional<SimTime> wakeAt_;
   std::uint64_t reads_{0};
+  std::uint64_t framesSentAgain_{0};
 };
 
 }  // namespace ecsim::master

@@ -292,8 +292,9 @@ TEST(ScanTest, SiiReadErrorsNameTheSlave) {
   net.segment().addSlave(slavesim::makeGenericSlave("A", 1));
   net.segment().wireLine();
   net.start();
-  // Every frame after the register reads is lost: the SII read times out and says where.
-  net.fault().dropSend = {5, 6, 7};
+  // Every frame after the register reads is lost: the SII read, sent again for its busy
+  // timeout (20 ms: 4 times 3 tries of 2 ms), times out and says where.
+  for (std::uint64_t n = 5; n < 100; ++n) net.fault().dropSend.insert(n);
   auto result = scan(net);
   ASSERT_FALSE(result.status.ok());
   EXPECT_EQ(result.status.error().code, ErrorCode::kTimeout);
