@@ -10,11 +10,13 @@
 
 #include <chrono>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 
 #include "link/fd.hpp"
 #include "link/link.hpp"
+#include "link/packet_rx_ring.hpp"
 #include "protocol/ethernet.hpp"
 
 struct msghdr;
@@ -31,8 +33,9 @@ struct RawSocketOptions {
   // (a capture) do not see the frames sent. `ecsim serve` sets it: its answers are seen
   // where the master's end receives them.
   bool qdiscBypass{false};
-  // receive() does not sleep: it asks the socket again and again until a frame is there or
-  // the timeout has passed. No wake-up on the answer's path, at the price of one core kept
+  // receive() does not sleep: it looks at a receive ring shared with the kernel
+  // (link/packet_rx_ring.hpp) again and again until a frame is there or the timeout has
+  // passed. No wake-up and no system call on the answer's path, at the price of one core kept
   // busy all the time (for a dedicated core: `ecsim serve --busy-poll`).
   bool busyPoll{false};
 };
@@ -63,11 +66,21 @@ class RawSocketLink final : public Link {
   bool kernelIgnoresOutgoing() const { return kernelIgnoresOutgoing_; }
   // Own frames that reached receive() and were skipped (only without kernel support).
   std::uint64_t outgoingSkipped() const { return outgoingSkipped_; }
+  // True when frames arrive through a receive ring (busyPoll): receive() with a zero timeout
+  // is then a look at memory, not a system call.
+  bool receivesWithoutSystemCalls() const { return ring_.has_value(); }
 
  private:
   RawSocketLink() = default;
   // Puts back the 802.1Q tag the kernel took off (reported in PACKET_AUXDATA).
   Result<std::size_t> restoreVlanTag(const msghdr& message, Bytes buffer, std::size_t length) const;
+  // Inserts `tpid` (0: 0x8100) and `tci` after the addresses of the `length` bytes in buffer.
+  Result<std::size_t> insertVlanTag(Bytes buffer, std::size_t length, std::uint16_t tpid,
+                                    std::uint16_t tci) const;
+  // receive() through the ring (busyPoll).
+  Result<std::size_t> receiveFromRing(Bytes buffer, std::chrono::nanoseconds timeout);
+  // Copies the ring's front frame into buffer (its tag put back): 0 when it is not for us.
+  Result<std::size_t> takeFromRing(const PacketRxRing::Frame& frame, Bytes buffer);
   // SO_RCVTIMEO, set only when it differs from the last one set.
   Status setReceiveTimeout(std::chrono::nanoseconds timeout);
 
@@ -79,6 +92,7 @@ class RawSocketLink final : public Link {
   bool kernelIgnoresOutgoing_{false};
   std::uint64_t outgoingSkipped_{0};
   bool busyPoll_{false};
+  std::optional<PacketRxRing> ring_;  // busyPoll: every frame arrives here
   std::chrono::nanoseconds receiveTimeout_{0};  // 0: none set (the socket waits for ever)
 };
 

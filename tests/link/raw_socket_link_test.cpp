@@ -42,7 +42,27 @@ class RawSocketLinkTest : public ::testing::Test {
   std::array<std::uint8_t, kMaxFrameSize> buf_{};
 };
 
-TEST_F(RawSocketLinkTest, CarriesEtherCatFramesBetweenTheEnds) {
+// The receive tests, each run twice: frames taken from the socket (recvmsg) and from the
+// receive ring that busy-polling uses (link/packet_rx_ring.hpp); both must hand over the same
+// frames, tags and errors.
+class RawSocketReceiveTest : public RawSocketLinkTest,
+                             public ::testing::WithParamInterface<bool> {
+ protected:
+  Result<RawSocketLink> open(const std::string& iface) {
+    auto link = RawSocketLink::open(
+        iface, RawSocketOptions{.netns = ns_->name(), .promiscuous = true, .busyPoll = GetParam()});
+    if (link.ok()) {
+      EXPECT_EQ(link->receivesWithoutSystemCalls(), GetParam());
+    }
+    return link;
+  }
+};
+
+std::string receiveName(const ::testing::TestParamInfo<bool>& info) {
+  return info.param ? "Ring" : "Socket";
+}
+
+TEST_P(RawSocketReceiveTest, CarriesEtherCatFramesBetweenTheEnds) {
   auto master = open(ns_->masterInterface());
   ASSERT_TRUE(master.ok()) << master.error().message();
   auto sim = open(ns_->simulatorInterface());
@@ -70,7 +90,7 @@ TEST_F(RawSocketLinkTest, CarriesEtherCatFramesBetweenTheEnds) {
 // An 802.1Q-tagged EtherCAT frame arrives with its tag where it was on the wire: the kernel
 // strips the tag before the socket and reports it aside (PACKET_AUXDATA); receive() puts it
 // back, so an answer built in place carries it as a real ESC passes it through.
-TEST_F(RawSocketLinkTest, ReceivesAVlanTaggedFrameWithItsTag) {
+TEST_P(RawSocketReceiveTest, ReceivesAVlanTaggedFrameWithItsTag) {
   auto master = open(ns_->masterInterface());
   ASSERT_TRUE(master.ok()) << master.error().message();
   auto sim = open(ns_->simulatorInterface());
@@ -93,7 +113,7 @@ TEST_F(RawSocketLinkTest, ReceivesAVlanTaggedFrameWithItsTag) {
   EXPECT_EQ(std::vector<std::uint8_t>(buf_.begin(), buf_.begin() + static_cast<long>(*n)), plain);
 }
 
-TEST_F(RawSocketLinkTest, DoesNotDeliverOtherEtherTypes) {
+TEST_P(RawSocketReceiveTest, DoesNotDeliverOtherEtherTypes) {
   auto master = open(ns_->masterInterface());
   auto sim = open(ns_->simulatorInterface());
   ASSERT_TRUE(master.ok() && sim.ok());
@@ -110,7 +130,7 @@ TEST_F(RawSocketLinkTest, DoesNotDeliverOtherEtherTypes) {
   EXPECT_EQ(*n, 0u);
 }
 
-TEST_F(RawSocketLinkTest, DoesNotReceiveItsOwnFrames) {
+TEST_P(RawSocketReceiveTest, DoesNotReceiveItsOwnFrames) {
   auto master = open(ns_->masterInterface());
   auto sim = open(ns_->simulatorInterface());
   ASSERT_TRUE(master.ok() && sim.ok());
@@ -124,7 +144,7 @@ TEST_F(RawSocketLinkTest, DoesNotReceiveItsOwnFrames) {
   EXPECT_EQ(*peer, 60u);
 }
 
-TEST_F(RawSocketLinkTest, PollFdSignalsAWaitingFrame) {
+TEST_P(RawSocketReceiveTest, PollFdSignalsAWaitingFrame) {
   auto master = open(ns_->masterInterface());
   auto sim = open(ns_->simulatorInterface());
   ASSERT_TRUE(master.ok() && sim.ok());
@@ -136,7 +156,7 @@ TEST_F(RawSocketLinkTest, PollFdSignalsAWaitingFrame) {
   EXPECT_EQ(*n, 60u);
 }
 
-TEST_F(RawSocketLinkTest, TimesOutAndRefusesBadFrames) {
+TEST_P(RawSocketReceiveTest, TimesOutAndRefusesBadFrames) {
   auto master = open(ns_->masterInterface());
   ASSERT_TRUE(master.ok());
   const auto start = std::chrono::steady_clock::now();
@@ -183,7 +203,7 @@ TEST_F(RawSocketLinkTest, BusyPollAndQdiscBypassCarryFramesAndKeepTheTimeout) {
   EXPECT_EQ(*n, 0u) << "its own frame does not come back";
 }
 
-TEST_F(RawSocketLinkTest, SmallReceiveBufferIsAnError) {
+TEST_P(RawSocketReceiveTest, SmallReceiveBufferIsAnError) {
   auto master = open(ns_->masterInterface());
   auto sim = open(ns_->simulatorInterface());
   ASSERT_TRUE(master.ok() && sim.ok());
@@ -238,6 +258,8 @@ TEST_F(RawSocketLinkTest, NamesCapNetRawWhenRefused) {
   });
   EXPECT_EQ(code, 0) << "1: opened anyway, 2: wrong code, 3: message lacks CAP_NET_RAW";
 }
+
+INSTANTIATE_TEST_SUITE_P(Both, RawSocketReceiveTest, ::testing::Bool(), receiveName);
 
 }  // namespace
 }  // namespace ecsim
