@@ -104,6 +104,10 @@ class Esc {
   void prefetchMemory(std::uint32_t address) const {
     if (address < memory_.size()) __builtin_prefetch(memory_.data() + address);
   }
+  // While no frame is there (a server waiting): asks for what a frame's pass reads first, the
+  // hot group, the memory line at `address` (the last frame's first physical ADO), the active
+  // FMMUs and the process RAM and buffers they lead to (esc_fmmu.cpp).
+  void prefetchForNextFrame(std::uint32_t address) const;
   // Read from copies kept beside the per-frame state (refreshAddressing()), so that a frame
   // passing ESCs it does not address touches none of their memory.
   std::uint16_t stationAddress() const { return station_; }

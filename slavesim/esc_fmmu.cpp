@@ -12,6 +12,15 @@ Esc::FmmuConfig Esc::fmmuConfig(unsigned n) const {
   return FmmuBlock::parse(ConstBytes(memory_).subspan(reg::fmmuChannel(n), reg::kFmmuSize)).value();
 }
 
+void Esc::prefetchForNextFrame(std::uint32_t address) const {
+  prefetchFrameState();
+  prefetchMemory(address);
+  for (std::size_t i = 0; i < activeFmmuCount_; ++i) {
+    prefetchMemory(activeFmmus_[i].physicalStartBit / 8);
+  }
+  if (!buffers_.empty()) __builtin_prefetch(buffers_.data());
+}
+
 void Esc::rebuildFmmuCache() {
   activeFmmuCount_ = 0;
   for (unsigned n = 0; n < type_.fmmus; ++n) {

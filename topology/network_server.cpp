@@ -17,6 +17,9 @@ constexpr SimTime kPacedSpin = 200 * kNsPerUs;
 // the one before.
 constexpr int kRedundantBurst = 8;
 constexpr std::chrono::nanoseconds kPairWait = std::chrono::microseconds(200);
+// ESCs fetched ahead between two looks at the link (prefetchWhileIdle): about 0.2 us of work
+// at 7 ns each, all a frame arriving meanwhile waits.
+constexpr std::size_t kPrefetchGroup = 32;
 
 }  // namespace
 
@@ -93,6 +96,18 @@ Result<std::size_t> NetworkServer::receiveEither(std::chrono::nanoseconds wait, 
   return std::size_t{0};
 }
 
+Result<std::size_t> NetworkServer::receiveWhilePrefetching(std::chrono::nanoseconds wait) {
+  for (;;) {
+    auto r = link_.receive(buffer_, std::chrono::nanoseconds::zero());
+    if (!r.ok() || *r != 0) return r;
+    if (prefetchNext_ >= segment_.size()) {
+      prefetchNext_ = SIZE_MAX;
+      return link_.receive(buffer_, wait);
+    }
+    prefetchNext_ = segment_.prefetchForNextFrame(prefetchNext_, kPrefetchGroup);
+  }
+}
+
 Status NetworkServer::step(const std::function<bool()>& stop) {
   // A firmware run put off: the wait for the next frame ends when it is due, so that the
   // last frame of a burst is followed by the firmware's reaction as promptly as before.
@@ -120,7 +135,9 @@ Status NetworkServer::step(const std::function<bool()>& stop) {
 
 Status NetworkServer::answer(std::chrono::nanoseconds wait, const std::function<bool()>& stop) {
   MasterPort from = MasterPort::kPrimary;
-  auto received = redundant_ == nullptr ? link_.receive(buffer_, wait) : receiveEither(wait, from);
+  auto received = redundant_ != nullptr          ? receiveEither(wait, from)
+                  : prefetchNext_ != SIZE_MAX ? receiveWhilePrefetching(wait)
+                                              : link_.receive(buffer_, wait);
   const SimTime now = clock_.now();
   if (!received.ok()) {
     ++counters_.receiveErrors;  // e.g. an oversize frame: dropped by the link
@@ -161,6 +178,7 @@ Status NetworkServer::answer(std::chrono::nanoseconds wait, const std::function<
   } else {
     ++counters_.framesAnswered;
   }
+  if (options_.prefetchWhileIdle) prefetchNext_ = 0;
   // The firmware reacts after the frame has passed, as on hardware.
   runFirmware(false);
   return okStatus();

@@ -36,6 +36,12 @@ struct ServerOptions {
   // for the next frame when it is due. A clock that does not advance while
   // the firmware runs (virtual time) makes every run due: the same as 0.
   unsigned firmwareSpacing{0};
+  // Between frames, while none is there, ask the cache for the ESCs' state ahead of the next
+  // frame (Segment::prefetchForNextFrame), a group at a time, looking at the link between
+  // groups; a frame that arrives ends the pass. Only for a link that looks without a system
+  // call (a RawSocketLink with busyPoll, `ecsim serve --busy-poll`): otherwise each look
+  // would undo what the pass brought in.
+  bool prefetchWhileIdle{false};
   // Sees every malformed frame the server drops, as received, stamped with the clock's time
   // (`ecsim serve --pcap-malformed`). Not owned; null: none.
   CableObserver* malformedObserver{nullptr};
@@ -79,6 +85,9 @@ class NetworkServer {
   Status step(const std::function<bool()>& stop);
   // Waits up to `wait` for one frame, answers it and runs the firmware.
   Status answer(std::chrono::nanoseconds wait, const std::function<bool()>& stop);
+  // prefetchWhileIdle: a frame already there, else the rest of the pass over the ESCs a
+  // group at a time while none comes, then the wait.
+  Result<std::size_t> receiveWhilePrefetching(std::chrono::nanoseconds wait);
   // Paced: holds until `t` on the clock; false when stop() was raised first.
   bool waitUntil(SimTime t, const std::function<bool()>& stop);
   // Runs the firmware now, or (firmwareSpacing) only when it is due; `idle`: always.
@@ -91,6 +100,7 @@ class NetworkServer {
   SimTime firmwareDoneAt_{0};    // when the last firmware run ended
   SimTime firmwareTook_{0};      // how long it took
   bool firmwarePending_{false};  // a run was put off
+  std::size_t prefetchNext_{SIZE_MAX};  // the next ESC of the pass (SIZE_MAX: none under way)
   std::array<std::uint8_t, kMaxFrameSize> buffer_{};
 };
 

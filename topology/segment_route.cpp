@@ -53,6 +53,7 @@ void Segment::passRoute(std::size_t count, const std::array<SimTime, 128>& leads
       address = datagrams_[i].ado();
     }
   }
+  if (physical) lastPhysicalAdo_ = address;
   if (indexedPasses_ && !everywhere && passRouteAddressed(count, leads, sendTime)) return;
   if (addressedOnly) {
     passRouteIndexed(count, leads, sendTime);
@@ -292,6 +293,12 @@ void Segment::visitAddressed(std::size_t pos, std::size_t count,
   }
   addIrq(count);
   if (esc.receiveTimeLatchArmed()) latched_.push_back(stop.slave);
+}
+
+std::size_t Segment::prefetchForNextFrame(std::size_t first, std::size_t count) const {
+  const std::size_t end = std::min(escs_.size(), first + count);
+  for (std::size_t i = first; i < end; ++i) escs_[i]->prefetchForNextFrame(lastPhysicalAdo_);
+  return end;
 }
 
 }  // namespace ecsim::topology

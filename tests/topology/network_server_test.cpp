@@ -195,5 +195,68 @@ TEST(NetworkServer, FirmwareSpacingAnswersBackToBackFramesBeforeTheFirmwareRuns)
   EXPECT_EQ(t.alStatusAnswer(), withoutSpacing) << "the firmware has acted on it now";
 }
 
+// The network end's link, noting the timeout of every receive() (the server's looks at it).
+class NotingLink final : public Link {
+ public:
+  explicit NotingLink(Link& inner) : inner_(inner) {}
+  Status send(ConstBytes frame) override { return inner_.send(frame); }
+  Result<std::size_t> receive(Bytes buffer, std::chrono::nanoseconds timeout) override {
+    timeouts.push_back(timeout);
+    return inner_.receive(buffer, timeout);
+  }
+  int pollFd() const override { return inner_.pollFd(); }
+  std::string describe() const override { return inner_.describe(); }
+  std::vector<std::chrono::nanoseconds> timeouts;
+
+ private:
+  Link& inner_;
+};
+
+// prefetchWhileIdle (`ecsim serve --busy-poll`): after an answer the server fetches the ESCs
+// ahead for the next frame 32 at a time, looking at the link (without waiting) between
+// groups, and only then waits; a frame that came meanwhile is answered at once, as it would
+// have been without the pass, and the answers are the same.
+TEST(NetworkServer, PrefetchWhileIdleLooksAtTheLinkBetweenGroupsAndAnswersAlike) {
+  std::vector<std::vector<std::uint8_t>> answers[2];
+  std::size_t looksBeforeTheWait[2]{};
+  for (int prefetch = 0; prefetch < 2; ++prefetch) {
+    topology::Segment seg;
+    buildLine(seg, 100);
+    auto [master, network] = MemoryLink::makePair();
+    NotingLink noting(network);
+    VirtualClock clock;
+    topology::ServerOptions options;
+    options.prefetchWhileIdle = prefetch == 1;
+    topology::NetworkServer server(noting, seg, clock, options);
+    std::array<std::uint8_t, kMaxFrameSize> buf{};
+    const std::size_t len = brdFrame(buf);
+    ASSERT_TRUE(master.send(ConstBytes(buf.data(), len)).ok());
+    ASSERT_TRUE(server.step().ok());
+    auto got = master.receive(buf, std::chrono::milliseconds(10));
+    ASSERT_TRUE(got.ok() && *got == len);
+    answers[prefetch].emplace_back(buf.begin(), buf.begin() + static_cast<long>(len));
+    // No frame: the pass, then the wait.
+    noting.timeouts.clear();
+    ASSERT_TRUE(server.step().ok());
+    ASSERT_FALSE(noting.timeouts.empty());
+    EXPECT_GT(noting.timeouts.back(), std::chrono::nanoseconds::zero()) << "it ends waiting";
+    looksBeforeTheWait[prefetch] = noting.timeouts.size() - 1;
+    for (std::size_t i = 0; i + 1 < noting.timeouts.size(); ++i) {
+      EXPECT_EQ(noting.timeouts[i], std::chrono::nanoseconds::zero());
+    }
+    // A frame already there when the step begins is answered in it, pass or not.
+    brdFrame(buf);
+    ASSERT_TRUE(master.send(ConstBytes(buf.data(), len)).ok());
+    ASSERT_TRUE(server.step().ok());
+    got = master.receive(buf, std::chrono::milliseconds(10));
+    ASSERT_TRUE(got.ok() && *got == len);
+    answers[prefetch].emplace_back(buf.begin(), buf.begin() + static_cast<long>(len));
+  }
+  EXPECT_EQ(answers[0], answers[1]);
+  EXPECT_EQ(looksBeforeTheWait[0], 0u);
+  EXPECT_EQ(looksBeforeTheWait[1], 5u) << "100 ESCs, 32 at a time: a look before each group, "
+                                          "one after the last";
+}
+
 }  // namespace
 }  // namespace ecsim::testing

@@ -246,6 +246,9 @@ int runServe(ServeOptions o) {
   // The firmware runs after every frame (ServerOptions::firmwareSpacing stays 0): spaced, a
   // slow build (AddressSanitizer) left the SII EEPROM interface busy while the master's frames
   // came back to back, and a scan timed out (StudyLatencyVeth, DriveVeth, SOEM v2 simple_ng).
+  // Busy-polling looks at a receive ring without a system call, so the wait between frames
+  // can fetch the ESCs ahead for the next one (docs/timing.md, "Served path").
+  options.prefetchWhileIdle = o.busyPoll;
   options.malformedObserver = malformedTap;
   topology::NetworkServer server(*served, segment, clock, options);
   server.setRedundantLink(redundantLink.get());
@@ -353,8 +356,9 @@ CommandRunner addServeCommand(CLI::App& app) {
   cmd->add_flag("--quiet", opts->quiet, "Print only the final statistics");
   cmd->add_flag("--rt", opts->realtime, "Run with SCHED_FIFO priority and locked memory");
   cmd->add_flag("--busy-poll", opts->busyPoll,
-                "Wait for frames by polling the socket without sleeping: shorter round trips, "
-                "one core kept busy (for a dedicated core)");
+                "Wait for frames by polling a receive ring without sleeping, the slaves' state "
+                "fetched ahead meanwhile: shorter round trips, one core kept busy (for a "
+                "dedicated core)");
   cmd->add_flag("--status", opts->status, "Show a live status table (redrawn twice a second)");
   cmd->add_option("--status-json", opts->statusJson,
                   "Rewrite the status to FILE (JSON) twice a second");
