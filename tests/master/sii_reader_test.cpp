@@ -86,6 +86,17 @@ class SiiLostFramesTest : public ::testing::Test {
     return master::runTask(reader, transport_, net_.bus(), 10 * kNsPerSecond, "sii");
   }
 
+  // The read ends well with the slave's EEPROM image, after 4 answers were dropped.
+  void expectTheWholeImageRead() {
+    master::SiiReader reader(transport_, 0x1001, true);
+    ASSERT_TRUE(read(reader).ok());
+    ASSERT_TRUE(reader.status().ok()) << reader.status().error().message();
+    EXPECT_EQ(dropped_, 4);
+    const auto& eeprom = net_.segment().slave(0).esc().sii();
+    ASSERT_LE(reader.image().size(), eeprom.size());
+    EXPECT_TRUE(std::equal(reader.image().begin(), reader.image().end(), eeprom.begin()));
+  }
+
   SimNetwork net_;
   master::Transport transport_{net_.masterLink()};
   int seen_{0};
@@ -101,23 +112,12 @@ class SiiLostFramesTest : public ::testing::Test {
 // 0x1005: ... no answer (frame lost)").
 TEST_F(SiiLostFramesTest, AStatusReadLostFourTimesIsReadAgainWithinTheBusyTimeout) {
   dropAnswers(Command::kFprd, 3, 4);
-  master::SiiReader reader(transport_, 0x1001, true);
-  ASSERT_TRUE(read(reader).ok());
-  ASSERT_TRUE(reader.status().ok()) << reader.status().error().message();
-  EXPECT_EQ(dropped_, 4);
-  const auto& eeprom = net_.segment().slave(0).esc().sii();
-  ASSERT_LE(reader.image().size(), eeprom.size());
-  EXPECT_TRUE(std::equal(reader.image().begin(), reader.image().end(), eeprom.begin()));
+  expectTheWholeImageRead();
 }
 
 TEST_F(SiiLostFramesTest, AReadCommandLostFourTimesIsSentAgain) {
   dropAnswers(Command::kFpwr, 5, 4);
-  master::SiiReader reader(transport_, 0x1001, true);
-  ASSERT_TRUE(read(reader).ok());
-  ASSERT_TRUE(reader.status().ok()) << reader.status().error().message();
-  EXPECT_EQ(dropped_, 4);
-  const auto& eeprom = net_.segment().slave(0).esc().sii();
-  EXPECT_TRUE(std::equal(reader.image().begin(), reader.image().end(), eeprom.begin()));
+  expectTheWholeImageRead();
 }
 
 // A slave whose answers stay away fails the read once 20 ms have passed since its command,
