@@ -48,7 +48,6 @@ Result<RawSocketLink> RawSocketLink::open(std::string_view interface,
   RawSocketLink link;
   link.interface_ = std::string(interface);
   link.netns_ = options.netns;
-  link.busyPoll_ = options.busyPoll;
   const std::string place = where(interface, options.netns);
 
   // Protocol 0 at creation: the socket receives nothing until bind() names the interface and
@@ -186,9 +185,10 @@ Result<std::size_t> RawSocketLink::receive(Bytes buffer, std::chrono::nanosecond
   // frame, where trying first and then polling took three. SO_RCVTIMEO counts in scheduler
   // ticks (4 ms at HZ=250), so a short wait (a master waiting for its frame, a server sharing
   // its thread with a master) tries first and then waits in poll(), whose timer is exact.
+  // Busy-polling looks at the receive ring instead, never at the socket.
   if (ring_) return receiveFromRing(buffer, timeout);
-  const bool wait = timeout >= kBlockingReceiveMin && !busyPoll_;
-  const bool pollWait = !wait && !busyPoll_ && timeout > std::chrono::nanoseconds::zero();
+  const bool wait = timeout >= kBlockingReceiveMin;
+  const bool pollWait = !wait && timeout > std::chrono::nanoseconds::zero();
   if (wait) ECSIM_TRY(setReceiveTimeout(timeout));
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   for (;;) {
@@ -216,7 +216,7 @@ Result<std::size_t> RawSocketLink::receive(Bytes buffer, std::chrono::nanosecond
               const bool readable,
               waitReadable(fd_.get(), std::chrono::duration_cast<std::chrono::nanoseconds>(left)));
           if (!readable) return std::size_t{0};
-        } else if (!busyPoll_) {
+        } else {
           return std::size_t{0};  // no wait asked for
         }
         continue;

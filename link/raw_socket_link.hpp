@@ -91,7 +91,6 @@ class RawSocketLink final : public Link {
   MacAddress mac_{};
   bool kernelIgnoresOutgoing_{false};
   std::uint64_t outgoingSkipped_{0};
-  bool busyPoll_{false};
   std::optional<PacketRxRing> ring_;  // busyPoll: every frame arrives here
   std::chrono::nanoseconds receiveTimeout_{0};  // 0: none set (the socket waits for ever)
 };
