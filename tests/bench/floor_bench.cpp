@@ -33,6 +33,7 @@
 
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -294,8 +295,9 @@ Result<Options> parse(int argc, char** argv) {
         o.slaves.push_back(static_cast<unsigned>(n));
       }
     } else if (a == "--cpu") {
-      o.cpu = std::atoi(v.c_str());
-      if (o.cpu < -1 || o.cpu >= ::sysconf(_SC_NPROCESSORS_ONLN)) {
+      const auto [end, error] = std::from_chars(v.data(), v.data() + v.size(), o.cpu);
+      if (error != std::errc() || end != v.data() + v.size() || o.cpu < -1 ||
+          o.cpu >= ::sysconf(_SC_NPROCESSORS_ONLN)) {
         return makeError(ErrorCode::kInvalidArgument, "--cpu: '" + v + "' is no CPU here");
       }
     } else if (a == "--serve") {
@@ -311,7 +313,8 @@ Result<Options> parse(int argc, char** argv) {
       o.serves.push_back(serve);
     } else {
       return makeError(ErrorCode::kInvalidArgument,
-                       "unknown option '" + a + "' (--round-trips, --rounds, --slaves, --cpu, --serve)");
+                       "unknown option '" + a +
+                           "' (--round-trips, --rounds, --slaves, --cpu, --serve)");
     }
   }
   if (o.serves.empty()) o.serves.push_back({"serve", ECSIM_BINARY, {}});
