@@ -33,6 +33,15 @@ build() {  # build PRESET
   cmake --build --preset "$1"
 }
 
+# timed WHAT COMMAND...: runs COMMAND, then says how long it took (CI keeps the whole run
+# under 40 minutes; these lines say where the time went).
+timed() {
+  local what=$1 start=$SECONDS
+  shift
+  "$@"
+  echo "run.sh: $what took $((SECONDS - start)) s"
+}
+
 case "${1:-}" in
   demo)
     install_missing
@@ -40,12 +49,12 @@ case "${1:-}" in
     ./build/default/tools/ecsim/ecsim demo --out ecsim-demo
     ;;
   test)
-    install_missing
-    build default
-    ctest --preset default -j2
-    build asan
-    ASAN_OPTIONS=detect_leaks=1 ctest --preset asan -j2
-    bash tests/fuzz/run_fuzz.sh build/fuzz 100000
+    timed "installing" install_missing
+    timed "the default build" build default
+    timed "the default tests" ctest --preset default -j2
+    timed "the asan build" build asan
+    timed "the asan tests" env ASAN_OPTIONS=detect_leaks=1 ctest --preset asan -j2
+    timed "fuzzing (build and runs)" bash tests/fuzz/run_fuzz.sh build/fuzz 100000
     ;;
   *)
     echo "usage: $0 demo|test" >&2
