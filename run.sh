@@ -7,7 +7,7 @@ set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")"
 
 packages=(
-  build-essential cmake ninja-build g++ clang libclang-rt-14-dev lld pkg-config
+  build-essential cmake ninja-build g++ clang libclang-rt-14-dev pkg-config
   libgtest-dev libgmock-dev libbenchmark-dev
   libtinyxml2-dev libpcap-dev libcli11-dev libfmt-dev libspdlog-dev nlohmann-json3-dev
   libeigen3-dev libre2-dev tshark gnuplot-nox iproute2 iputils-ping ethtool procps libxml2-utils
