@@ -114,6 +114,12 @@ Result<RawSocketLink> RawSocketLink::open(std::string_view interface,
     link.ring_.emplace(std::move(ring));
   }
 
+  if (options.sendCpu >= 0) {
+    ECSIM_ASSIGN_OR_RETURN(auto sender,
+                           KernelThreadSender::open(fd, options.sendCpu, "raw socket on " + place));
+    link.sender_.emplace(std::move(sender));
+  }
+
   sockaddr_ll addr{};
   addr.sll_family = AF_PACKET;
   // All EtherTypes, filtered in receive(): a socket bound to 0x88A4 gets a VLAN-tagged frame
@@ -144,14 +150,22 @@ Status RawSocketLink::send(ConstBytes frame) {
             std::to_string(kEthernetHeaderSize) + " to " + std::to_string(kMaxFrameSize) + ")");
   }
   for (;;) {
-    const ssize_t n = ::send(fd_.get(), frame.data(), frame.size(), 0);
+    ssize_t n = 0;
+    int err = 0;
+    if (sender_) {
+      ECSIM_ASSIGN_OR_RETURN(const long sent, sender_->send(frame));
+      n = sent < 0 ? -1 : sent;
+      err = sent < 0 ? static_cast<int>(-sent) : 0;
+    } else {
+      n = ::send(fd_.get(), frame.data(), frame.size(), 0);
+      err = errno;
+    }
     if (n == static_cast<ssize_t>(frame.size())) return okStatus();
     if (n >= 0) {
       return makeError(ErrorCode::kIo, describe() + ": short send of " + std::to_string(n) +
                                            " of " + std::to_string(frame.size()) + " bytes");
     }
-    if (errno == EINTR) continue;
-    const int err = errno;
+    if (err == EINTR) continue;
     if (err == ENETDOWN || err == ENXIO) {
       return makeError(ErrorCode::kIo, describe() + " is down: " + errnoText(err));
     }

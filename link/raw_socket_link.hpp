@@ -15,6 +15,7 @@
 #include <string_view>
 
 #include "link/fd.hpp"
+#include "link/kernel_thread_sender.hpp"
 #include "link/link.hpp"
 #include "link/packet_rx_ring.hpp"
 #include "protocol/ethernet.hpp"
@@ -38,6 +39,10 @@ struct RawSocketOptions {
   // passed. No wake-up and no system call on the answer's path, at the price of one core kept
   // busy all the time (for a dedicated core: `ecsim serve --busy-poll`).
   bool busyPoll{false};
+  // send() leaves the system call to a kernel thread polling on this CPU
+  // (link/kernel_thread_sender.hpp): with busyPoll, the calling thread then never enters the
+  // kernel between two frames. -1: send() calls send(2).
+  int sendCpu{-1};
 };
 
 class RawSocketLink final : public Link {
@@ -69,6 +74,10 @@ class RawSocketLink final : public Link {
   // True when frames arrive through a receive ring (busyPoll): receive() with a zero timeout
   // is then a look at memory, not a system call.
   bool receivesWithoutSystemCalls() const { return ring_.has_value(); }
+  // The sending thread (sendCpu), if any.
+  const KernelThreadSender* kernelThreadSender() const {
+    return sender_ ? &*sender_ : nullptr;
+  }
 
  private:
   RawSocketLink() = default;
@@ -92,6 +101,7 @@ class RawSocketLink final : public Link {
   bool kernelIgnoresOutgoing_{false};
   std::uint64_t outgoingSkipped_{0};
   std::optional<PacketRxRing> ring_;  // busyPoll: every frame arrives here
+  std::optional<KernelThreadSender> sender_;  // sendCpu: every frame leaves through it
   std::chrono::nanoseconds receiveTimeout_{0};  // 0: none set (the socket waits for ever)
 };
 

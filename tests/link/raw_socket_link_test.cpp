@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 #include <poll.h>
+#include <sched.h>
+#include <unistd.h>
 
 #include <array>
 #include <chrono>
@@ -201,6 +203,41 @@ TEST_F(RawSocketLinkTest, BusyPollAndQdiscBypassCarryFramesAndKeepTheTimeout) {
   n = sim->receive(buf_, 0ms);
   ASSERT_TRUE(n.ok());
   EXPECT_EQ(*n, 0u) << "its own frame does not come back";
+}
+
+// Issue 18: `ecsim serve --busy-poll` sends through a kernel thread on another CPU
+// (link/kernel_thread_sender.hpp). The frames reach the other end as with send(2), and an
+// interface that is down is reported the same way.
+TEST_F(RawSocketLinkTest, SendsThroughAKernelThreadOnAnotherCpu) {
+  const long cpus = ::sysconf(_SC_NPROCESSORS_ONLN);
+  ECSIM_REQUIRE_OR_SKIP(cpus >= 2, "one CPU: no other CPU for the sending thread");
+  const int cpu = (::sched_getcpu() + 1) % static_cast<int>(cpus);
+  auto master = open(ns_->masterInterface());
+  auto sim = RawSocketLink::open(
+      ns_->simulatorInterface(),
+      {.netns = ns_->name(), .qdiscBypass = true, .busyPoll = true, .sendCpu = cpu});
+  ASSERT_TRUE(master.ok()) << master.error().message();
+  if (!sim.ok() && sim.error().code == ErrorCode::kUnsupported) {
+    ECSIM_REQUIRE_OR_SKIP(false, sim.error().message());
+  }
+  ASSERT_TRUE(sim.ok()) << sim.error().message();
+  ASSERT_NE(sim->kernelThreadSender(), nullptr);
+  EXPECT_EQ(sim->kernelThreadSender()->cpu(), cpu);
+  for (std::uint8_t i = 0; i < 50; ++i) {
+    const auto reply = etherCatFrame(i);
+    ASSERT_TRUE(sim->send(reply).ok());
+    auto n = master->receive(buf_, 2s);
+    ASSERT_TRUE(n.ok()) << n.error().message();
+    ASSERT_EQ(std::vector<std::uint8_t>(buf_.begin(), buf_.begin() + 60), reply);
+  }
+  auto n = sim->receive(buf_, 0ms);
+  ASSERT_TRUE(n.ok());
+  EXPECT_EQ(*n, 0u) << "its own frames do not come back";
+
+  ASSERT_TRUE(ns_->run({"ip", "link", "set", "dev", ns_->simulatorInterface(), "down"}).ok());
+  const auto sent = sim->send(etherCatFrame(1));
+  ASSERT_FALSE(sent.ok());
+  EXPECT_NE(sent.error().context.find("is down"), std::string::npos) << sent.error().context;
 }
 
 TEST_P(RawSocketReceiveTest, SmallReceiveBufferIsAnError) {

@@ -4,7 +4,9 @@
 // addressing, same frame length back, malformed frames dropped and counted without harm,
 // SIGINT stops cleanly and the capture decodes in tshark.
 #include <gtest/gtest.h>
+#include <sched.h>
 #include <signal.h>
+#include <unistd.h>
 
 #include <array>
 #include <filesystem>
@@ -161,6 +163,40 @@ TEST_P(ServeVeth, BroadcastReadCountsEverySlave) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Sizes, ServeVeth, ::testing::Values(1u, 10u, 250u));
+
+// Issue 18: `--busy-poll` answers through a kernel thread on another CPU
+// (link/kernel_thread_sender.hpp), says which, and keeps its own thread off that CPU: a
+// busy-polling thread at real-time priority beside it would starve it.
+TEST(ServeVethBusyPoll, AnswersThroughAKernelThreadOnACpuItLeaves) {
+  ECSIM_REQUIRE_NETWORK();
+  ASSERT_GE(::sysconf(_SC_NPROCESSORS_ONLN), 2) << "CI machines have 2 CPUs";
+  auto ns = VethNamespace::create();
+  ASSERT_TRUE(ns.ok()) << ns.error().message();
+  const std::string log = uniqueTempPath("serve_busy.log");
+  ServedNetwork net(*ns, 10, "", log, {"--busy-poll", "--rt"});
+  ASSERT_TRUE(net.ok());
+  ASSERT_TRUE(net.waitReady()) << readText(log);
+  for (int i = 0; i < 200; ++i) {
+    auto brd = net.datagram(Command::kBrd, DatagramHeader::physical(0, 0x0000), {0, 0});
+    ASSERT_TRUE(brd);
+    ASSERT_EQ(brd->first, 10);
+  }
+  const std::string out = readText(log);
+  const std::string said = "answers sent by a kernel thread on CPU ";
+  const auto at = out.find(said);
+  ASSERT_NE(at, std::string::npos) << out;
+  const int cpu = std::atoi(out.c_str() + at + said.size());
+  // The server's own affinity leaves the sending CPU out.
+  cpu_set_t set;
+  ASSERT_EQ(::sched_getaffinity(net.child().pid(), sizeof set, &set), 0);
+  EXPECT_FALSE(CPU_ISSET(cpu, &set)) << "the server may still run on CPU " << cpu;
+  EXPECT_GE(CPU_COUNT(&set), 1);
+  ASSERT_TRUE(net.child().kill(SIGINT).ok());
+  auto code = net.child().wait(kExitWait);
+  ASSERT_TRUE(code.ok());
+  EXPECT_EQ(*code, 0) << readText(log);
+  if (!HasFailure()) std::filesystem::remove(log);
+}
 
 // Random frames aimed at the simulator: it must drop what is malformed, count it, keep
 // running, and still answer correctly afterwards.

@@ -9,9 +9,12 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "config/topology_file.hpp"
 #include "link/pcap.hpp"
@@ -60,6 +63,48 @@ struct ServeOptions {
   std::string control;     // live-injection socket; empty: /run/ecsim/<interface>.sock
 };
 
+namespace {
+
+// The online CPUs (/sys/devices/system/cpu/online: "0-3", "0,2-5").
+std::vector<int> onlineCpus() {
+  std::vector<int> cpus;
+  std::ifstream in("/sys/devices/system/cpu/online");
+  std::string list;
+  std::getline(in, list);
+  std::stringstream items(list);
+  std::string item;
+  while (std::getline(items, item, ',')) {
+    const auto dash = item.find('-');
+    const int first = std::atoi(item.substr(0, dash).c_str());
+    const int last = dash == std::string::npos ? first : std::atoi(item.substr(dash + 1).c_str());
+    for (int c = first; c <= last && c < CPU_SETSIZE; ++c) cpus.push_back(c);
+  }
+  return cpus;
+}
+
+// --busy-poll: the CPU for the kernel thread that sends the answers
+// (link/kernel_thread_sender.hpp). Never one the server runs on, where its busy-polling at
+// real-time priority would starve that thread: an online CPU outside this process's affinity
+// when there is one (the server was confined, e.g. `taskset -c 1`), else the last CPU of the
+// affinity, which the process then leaves. -1 on a single CPU: the answers go out with
+// send(2). `restore` is the affinity to go back to if the sender cannot be made.
+int claimSendCpu(cpu_set_t& restore) {
+  CPU_ZERO(&restore);
+  if (sched_getaffinity(0, sizeof restore, &restore) != 0) return -1;
+  const std::vector<int> online = onlineCpus();
+  for (int c : online) {
+    if (!CPU_ISSET(c, &restore)) return c;
+  }
+  if (CPU_COUNT(&restore) < 2 || online.empty()) return -1;
+  const int cpu = online.back();
+  cpu_set_t rest = restore;
+  CPU_CLR(cpu, &rest);
+  if (sched_setaffinity(0, sizeof rest, &rest) != 0) return -1;
+  return cpu;
+}
+
+}  // namespace
+
 int runServe(ServeOptions o) {
   if (static_cast<int>(!o.iface.empty()) + static_cast<int>(!o.tap.empty()) +
           static_cast<int>(!o.veth.empty()) !=
@@ -93,13 +138,38 @@ int runServe(ServeOptions o) {
     fmt::print(stderr, "ecsim serve: --redundant-iface needs --iface or --veth\n");
     return 2;
   }
+  // --busy-poll: the answers leave through a kernel thread on another CPU, so that the
+  // server's thread never enters the kernel between frames (docs/timing.md, "Served path").
+  cpu_set_t affinityBefore;
+  int sendCpu = o.busyPoll ? claimSendCpu(affinityBefore) : -1;
+  if (o.busyPoll && sendCpu < 0) {
+    fmt::print(stderr,
+               "ecsim serve: note: --busy-poll on a single CPU: answers are sent with send(2)\n");
+  }
+  // Opens a raw socket for serving; without the sending thread (and a note) when the kernel
+  // refuses it.
+  auto openServed = [&](const std::string& name) -> Result<RawSocketLink> {
+    RawSocketOptions options{.netns = o.netns,
+                             .promiscuous = true,
+                             .qdiscBypass = true,
+                             .busyPoll = o.busyPoll,
+                             .sendCpu = sendCpu};
+    auto raw = RawSocketLink::open(name, options);
+    if (raw.ok() || sendCpu < 0 || (raw.error().code != ErrorCode::kUnsupported &&
+                                    raw.error().code != ErrorCode::kInvalidArgument)) {
+      return raw;
+    }
+    fmt::print(stderr, "ecsim serve: note: {}; answers are sent with send(2)\n",
+               raw.error().message());
+    sendCpu = -1;
+    (void)sched_setaffinity(0, sizeof affinityBefore, &affinityBefore);
+    options.sendCpu = -1;
+    return RawSocketLink::open(name, options);
+  };
   std::unique_ptr<Link> link;
   std::unique_ptr<Link> redundantLink;
   if (!o.redundantIface.empty()) {
-    auto raw = RawSocketLink::open(
-        o.redundantIface,
-        RawSocketOptions{
-            .netns = o.netns, .promiscuous = true, .qdiscBypass = true, .busyPoll = o.busyPoll});
+    auto raw = openServed(o.redundantIface);
     if (!raw.ok()) {
       fmt::print(stderr, "ecsim serve: {}\n", raw.error().message());
       return 1;
@@ -107,10 +177,7 @@ int runServe(ServeOptions o) {
     redundantLink = std::make_unique<RawSocketLink>(std::move(raw).value());
   }
   if (!o.iface.empty()) {
-    auto raw = RawSocketLink::open(
-        o.iface,
-        RawSocketOptions{
-            .netns = o.netns, .promiscuous = true, .qdiscBypass = true, .busyPoll = o.busyPoll});
+    auto raw = openServed(o.iface);
     if (!raw.ok()) {
       fmt::print(stderr, "ecsim serve: {}\n", raw.error().message());
       return 1;
@@ -257,6 +324,11 @@ int runServe(ServeOptions o) {
     fmt::print("ecsim: serving {} slave(s) on {}{}{}\n", segment.size(), link->describe(),
                redundantLink ? " and, redundant, " + redundantLink->describe() : std::string(),
                o.pcap.empty() ? "" : fmt::format(", capturing to {}", o.pcap));
+    if (sendCpu >= 0) {
+      fmt::print("ecsim: busy-polling; answers sent by a kernel thread on CPU {} (io_uring), "
+                 "this process kept off it\n",
+                 sendCpu);
+    }
     std::fflush(stdout);
   }
   StatusReporter reporter(o.status, o.statusJson);
@@ -357,8 +429,8 @@ CommandRunner addServeCommand(CLI::App& app) {
   cmd->add_flag("--rt", opts->realtime, "Run with SCHED_FIFO priority and locked memory");
   cmd->add_flag("--busy-poll", opts->busyPoll,
                 "Wait for frames by polling a receive ring without sleeping, the slaves' state "
-                "fetched ahead meanwhile: shorter round trips, one core kept busy (for a "
-                "dedicated core)");
+                "fetched ahead meanwhile, the answers sent by a kernel thread on another CPU: "
+                "shorter round trips, two cores kept busy (for dedicated cores)");
   cmd->add_flag("--status", opts->status, "Show a live status table (redrawn twice a second)");
   cmd->add_option("--status-json", opts->statusJson,
                   "Rewrite the status to FILE (JSON) twice a second");
