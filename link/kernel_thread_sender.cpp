@@ -46,9 +46,9 @@ T* field(void* map, unsigned offset) {
 
 // Whether the kernel knows IORING_OP_SEND (Linux 5.6): asked once, at open().
 bool sendSupported(int ring) {
-  alignas(io_uring_probe) std::array<std::uint8_t, sizeof(io_uring_probe) +
-                                                        IORING_OP_LAST * sizeof(io_uring_probe_op)>
-      bytes{};
+  alignas(io_uring_probe)
+      std::array<std::uint8_t, sizeof(io_uring_probe) + IORING_OP_LAST * sizeof(io_uring_probe_op)>
+          bytes{};
   auto* probe = reinterpret_cast<io_uring_probe*>(bytes.data());
   if (ioUringRegister(ring, IORING_REGISTER_PROBE, probe, IORING_OP_LAST) != 0) return false;
   return probe->last_op >= IORING_OP_SEND &&
@@ -139,7 +139,9 @@ KernelThreadSender& KernelThreadSender::operator=(KernelThreadSender&& other) no
   return *this;
 }
 
-KernelThreadSender::~KernelThreadSender() { release(); }
+KernelThreadSender::~KernelThreadSender() {
+  release();
+}
 
 void KernelThreadSender::release() {
   if (sqes_ != nullptr) ::munmap(sqes_, sqesBytes_);
@@ -171,8 +173,7 @@ Result<long> KernelThreadSender::send(ConstBytes frame) {
   if ((__atomic_load_n(sqFlags_, __ATOMIC_RELAXED) & IORING_SQ_NEED_WAKEUP) != 0) {
     ++wakeUps_;
     if (ioUringEnter(ring_.get(), 0, 0, IORING_ENTER_SQ_WAKEUP) < 0 && errno != EINTR) {
-      return makeError(ErrorCode::kIo, where_ + ": waking the sending thread: " +
-                                           errnoText(errno));
+      return makeError(ErrorCode::kIo, where_ + ": waking the sending thread: " + errnoText(errno));
     }
   }
   return awaitCompletion();

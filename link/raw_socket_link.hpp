@@ -75,9 +75,7 @@ class RawSocketLink final : public Link {
   // is then a look at memory, not a system call.
   bool receivesWithoutSystemCalls() const { return ring_.has_value(); }
   // The sending thread (sendCpu), if any.
-  const KernelThreadSender* kernelThreadSender() const {
-    return sender_ ? &*sender_ : nullptr;
-  }
+  const KernelThreadSender* kernelThreadSender() const { return sender_ ? &*sender_ : nullptr; }
 
  private:
   RawSocketLink() = default;
@@ -100,8 +98,8 @@ class RawSocketLink final : public Link {
   MacAddress mac_{};
   bool kernelIgnoresOutgoing_{false};
   std::uint64_t outgoingSkipped_{0};
-  std::optional<PacketRxRing> ring_;  // busyPoll: every frame arrives here
-  std::optional<KernelThreadSender> sender_;  // sendCpu: every frame leaves through it
+  std::optional<PacketRxRing> ring_;            // busyPoll: every frame arrives here
+  std::optional<KernelThreadSender> sender_;    // sendCpu: every frame leaves through it
   std::chrono::nanoseconds receiveTimeout_{0};  // 0: none set (the socket waits for ever)
 };
 

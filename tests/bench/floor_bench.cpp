@@ -1,20 +1,20 @@
 // How far `ecsim serve` is above the floor (issue 18). In a private network namespace with one
 // veth pair (VethNamespace), this program talks on the master end as a ping-pong
-// client: one 64-byte BRD frame (60 bytes + FCS; 32 data bytes from 0x0000) in flight, the
-// next sent when the answer is back, on SCHED_FIFO where permitted. On the simulator's end it
+// client: one frame in flight (tests/bench/floor_workload.hpp: a 64-byte BRD, or with
+// --frame cycle sim_bench's cyclic LRW frames in turn after their set-up frames), the next
+// sent when the answer is back, on SCHED_FIFO where permitted. On the simulator's end it
 // starts, one after the other and alternating, the floor responder (tests/bench/
 // floor_responder.cpp: receive, bump the working counter, send back; no simulation) and
 // `ecsim serve --rt --slaves N`, for each slave count. It prints the median and 99th
 // percentile round trip of each, the difference to the floor, and the cost per slave seen
 // from outside ((difference at N - difference at 1) / (N - 1), and between the two largest
-// counts) beside the same frame's cost
-// per slave measured in this process (Segment::processFrame with warm caches and with cold
-// ones, and Segment::pollSlaves, the firmware the server runs between frames). A figure,
-// never a pass/fail on timing: the exit status is 1 only when a responder did not answer, or
-// answered with a wrong working counter.
+// counts) beside the same frames' cost per slave measured in this process (Segment::processFrame
+// with warm caches and with cold ones, and Segment::pollSlaves, the firmware the server runs
+// between frames). A figure, never a pass/fail on timing: the exit status is 1 only when a
+// responder did not answer, or answered with a wrong working counter.
 //
 //   floor_bench [--round-trips N] [--rounds R] [--slaves 1,10,60,250,1000] [--cpu C]
-//               [--serve 'NAME=PATH [ARG...]']...
+//               [--frame brd|cycle] [--serve 'NAME=PATH [ARG...]']...
 //
 // --cpu: the responders run on CPU C (through taskset) and the in-process figures are
 // measured there too, the client on the other CPUs; default the last CPU when there are two
@@ -48,17 +48,14 @@
 #include "link/raw_socket_link.hpp"
 #include "link/signal_flag.hpp"
 #include "protocol/frame.hpp"
-#include "slavesim/generic_slave.hpp"
+#include "tests/bench/floor_workload.hpp"
 #include "tests/support/ci_mode.hpp"
-#include "topology/segment.hpp"
 
 namespace ecsim {
 namespace {
 
 using Clock = std::chrono::steady_clock;
 
-constexpr std::uint16_t kPingData = 32;  // 14 + 2 + 10 + 32 + 2 = 60 bytes, 64 with the FCS
-constexpr std::size_t kIndexAt = kEthernetHeaderSize + 2 + 1;  // first datagram's index
 constexpr std::size_t kSourceMacAt = 6;
 constexpr std::uint8_t kProcessedBit = 0x02;  // an ESC sets the locally administered bit
 constexpr int kClientPriority = 70;           // below the responders' 80 (`serve --rt`)
@@ -77,7 +74,8 @@ struct Options {
     std::vector<std::string> args;
   };
   std::vector<Serve> serves;
-  int cpu{-2};  // -2: the default (the last CPU when there are two or more), -1: none
+  int cpu{-2};               // -2: the default (the last CPU when there are two or more), -1: none
+  std::string frame{"brd"};  // tests/bench/floor_workload.hpp
 };
 
 // Pins the calling thread to `cpu` (>= 0) or to every CPU but it (`others`).
@@ -110,34 +108,47 @@ std::string loadAverage() {
   return one + " " + five + " " + fifteen;
 }
 
-std::vector<std::uint8_t> pingFrame() {
-  std::array<std::uint8_t, kMaxFrameSize> buf{};
-  FrameBuilder b(
-      buf, EthernetHeader{kBroadcastMac, {0x10, 0, 0, 0, 0, 1}, std::nullopt, kEtherTypeEtherCat});
-  (void)b.add(Command::kBrd, 0, 0, kPingData);
-  auto len = b.finish();
-  return {buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(len.ok() ? *len : 0)};
-}
-
 // The ping-pong client on the master's end of the pair.
 class Client {
  public:
-  explicit Client(RawSocketLink link) : link_(std::move(link)), frame_(pingFrame()) {
-    samples_.reserve(1 << 16);
+  explicit Client(RawSocketLink link) : link_(std::move(link)) { samples_.reserve(1 << 16); }
+
+  // What to send from now on, and the working counters to expect of its cycle frames (of the
+  // set-up frames: 1); `floor`: 1 everywhere, as the floor responder adds 1 to every WKC.
+  void use(const bench::Workload& w, bool floor) {
+    workload_ = &w;
+    floor_ = floor;
+    next_ = 0;
   }
 
-  // One round trip; the time in µs, or a negative value when no answer came in time. An
-  // answer with another working counter than `wkc` is an error.
-  Result<double> roundTrip(std::uint16_t wkc) {
-    frame_[kIndexAt] = ++index_;
+  // Sends the workload's set-up frames, each answered with WKC 1.
+  Status setup() {
+    for (const auto& f : workload_->setup) {
+      frame_ = f;
+      ECSIM_ASSIGN_OR_RETURN(const double us, exchange(1));
+      if (us < 0) return makeError(ErrorCode::kTimeout, "a set-up frame was not answered");
+    }
+    return okStatus();
+  }
+
+  // One round trip of the next cycle frame; the time in µs, or a negative value when no
+  // answer came in time. An answer with another working counter than expected is an error.
+  Result<double> roundTrip() {
+    const std::size_t k = next_++ % workload_->cycle.size();
+    frame_ = workload_->cycle[k];
+    return exchange(floor_ ? std::uint16_t{1} : workload_->servedWkc[k]);
+  }
+
+  Result<double> exchange(std::uint16_t wkc) {
+    frame_[bench::indexOffset()] = ++index_;
     const auto start = Clock::now();
     ECSIM_TRY(link_.send(frame_));
     for (;;) {
       ECSIM_ASSIGN_OR_RETURN(const std::size_t n, link_.receive(in_, kAnswerWait));
       const auto now = Clock::now();
       if (n == frame_.size() && (in_[kSourceMacAt] & kProcessedBit) != 0 &&
-          in_[kIndexAt] == index_) {
-        const std::uint16_t got = readLe16(in_, n - 2);
+          in_[bench::indexOffset()] == index_) {
+        const std::uint16_t got = bench::lastWkc(ConstBytes(in_.data(), n)).value_or(0);
         if (got != wkc) {
           return makeError(ErrorCode::kInvalidArgument,
                            fmt::format("answer with WKC {}, expected {}", got, wkc));
@@ -149,22 +160,27 @@ class Client {
   }
 
   // Waits (up to `limit`) until the responder answers at all.
-  bool waitReady(std::uint16_t wkc, std::chrono::seconds limit, const SignalFlag& stop) {
+  // A wrong working counter ends the wait at once.
+  Status waitReady(std::chrono::seconds limit, const SignalFlag& stop) {
     const auto deadline = Clock::now() + limit;
     while (Clock::now() < deadline && !stop.raised()) {
-      auto r = roundTrip(wkc);
-      if (r.ok() && *r >= 0) return true;
+      frame_ = workload_->cycle.front();
+      auto r = exchange(floor_ ? std::uint16_t{1} : workload_->servedWkc.front());
+      if (!r.ok() && r.error().code == ErrorCode::kInvalidArgument) return r.error();
+      if (r.ok() && *r >= 0) return okStatus();
     }
-    return false;
+    return makeError(
+        ErrorCode::kTimeout,
+        stop.raised() ? "interrupted" : "no answer within " + std::to_string(limit.count()) + " s");
   }
 
-  Result<Figures> measure(unsigned count, std::uint16_t wkc, const SignalFlag& stop) {
-    for (unsigned i = 0; i < kWarmUp && !stop.raised(); ++i) ECSIM_TRY(roundTrip(wkc));
+  Result<Figures> measure(unsigned count, const SignalFlag& stop) {
+    for (unsigned i = 0; i < kWarmUp && !stop.raised(); ++i) ECSIM_TRY(roundTrip());
     samples_.clear();
     Figures f;
     unsigned lostInARow = 0;
     while (samples_.size() < count && !stop.raised()) {
-      ECSIM_ASSIGN_OR_RETURN(const double us, roundTrip(wkc));
+      ECSIM_ASSIGN_OR_RETURN(const double us, roundTrip());
       if (us < 0) {
         ++f.lost;
         if (++lostInARow > kMaxLostInARow) {
@@ -186,6 +202,9 @@ class Client {
 
  private:
   RawSocketLink link_;
+  const bench::Workload* workload_{nullptr};
+  bool floor_{false};
+  std::size_t next_{0};
   std::vector<std::uint8_t> frame_;
   std::array<std::uint8_t, kMaxFrameSize> in_{};
   std::vector<double> samples_;
@@ -194,8 +213,8 @@ class Client {
 
 // Starts a responder in the namespace, measures it, stops it.
 Result<Figures> measureResponder(const VethNamespace& ns, Client& client,
-                                 const std::vector<std::string>& argv, std::uint16_t wkc,
-                                 unsigned count, const SignalFlag& stop) {
+                                 const std::vector<std::string>& argv, unsigned count,
+                                 const SignalFlag& stop) {
   const std::string log =
       (std::filesystem::temp_directory_path() / fmt::format("ecsim-floor-bench-{}.log", ::getpid()))
           .string();
@@ -209,67 +228,15 @@ Result<Figures> measureResponder(const VethNamespace& ns, Client& client,
     return makeError(ErrorCode::kIo,
                      fmt::format("{}: {}; its output:\n{}", argv.front(), what, s.str()));
   };
-  if (!client.waitReady(wkc, std::chrono::seconds(30), stop)) {
-    return failed(stop.raised() ? "interrupted" : "no answer within 30 s");
+  if (auto ready = client.waitReady(std::chrono::seconds(30), stop); !ready.ok()) {
+    return failed(ready.error().message());
   }
-  auto figures = client.measure(count, wkc, stop);
+  if (auto set = client.setup(); !set.ok()) return failed(set.error().message());
+  auto figures = client.measure(count, stop);
   if (!figures.ok()) return failed(figures.error().message());
   (void)child.stop();
   std::filesystem::remove(log);
   return figures;
-}
-
-// The same frame's cost in this process: ns per frame through processFrame, and per
-// pollSlaves, for a line of n generic slaves.
-struct InProcess {
-  double frameNs{0};
-  double coldFrameNs{0};  // each frame after the caches were filled with other data
-  double pollNs{0};
-};
-
-// Larger than this machine's caches: writing it evicts what a frame would find cached, as
-// the processes that run while a server sleeps between frames do.
-constexpr std::size_t kEvictBytes = 32u << 20;
-
-InProcess inProcess(unsigned n) {
-  topology::Segment seg;
-  for (unsigned i = 0; i < n; ++i) {
-    seg.addSlave(slavesim::makeGenericSlave(fmt::format("Slave{}", i + 1), i + 1));
-  }
-  seg.wireLine();
-  const auto ping = pingFrame();
-  std::vector<std::uint8_t> frame(ping);
-  auto timeLoop = [](auto&& body) {
-    std::vector<double> perCall;
-    for (int rep = 0; rep < 5; ++rep) {  // median of 5 runs of ~20 ms
-      unsigned calls = 0;
-      const auto start = Clock::now();
-      auto now = start;
-      while (now - start < std::chrono::milliseconds(20)) {
-        for (int i = 0; i < 16; ++i) body(calls++);
-        now = Clock::now();
-      }
-      perCall.push_back(std::chrono::duration<double, std::nano>(now - start).count() / calls);
-    }
-    return median(perCall);
-  };
-  InProcess r;
-  r.frameNs = timeLoop([&](unsigned i) {
-    std::copy(ping.begin(), ping.end(), frame.begin());
-    (void)seg.processFrame(frame, static_cast<SimTime>(i) * kNsPerUs);
-  });
-  std::vector<std::uint8_t> evict(kEvictBytes);
-  std::vector<double> cold;
-  for (unsigned i = 0; i < 200; ++i) {
-    for (std::size_t at = 0; at < evict.size(); at += 64) evict[at] = static_cast<std::uint8_t>(i);
-    std::copy(ping.begin(), ping.end(), frame.begin());
-    const auto start = Clock::now();
-    (void)seg.processFrame(frame, static_cast<SimTime>(i) * kNsPerUs);
-    cold.push_back(std::chrono::duration<double, std::nano>(Clock::now() - start).count());
-  }
-  r.coldFrameNs = median(cold);
-  r.pollNs = timeLoop([&](unsigned i) { seg.pollSlaves(static_cast<SimTime>(i) * kNsPerUs); });
-  return r;
 }
 
 Result<Options> parse(int argc, char** argv) {
@@ -301,6 +268,11 @@ Result<Options> parse(int argc, char** argv) {
           o.cpu >= ::sysconf(_SC_NPROCESSORS_ONLN)) {
         return makeError(ErrorCode::kInvalidArgument, "--cpu: '" + v + "' is no CPU here");
       }
+    } else if (a == "--frame") {
+      if (v != "brd" && v != "cycle") {
+        return makeError(ErrorCode::kInvalidArgument, "--frame: '" + v + "' (brd or cycle)");
+      }
+      o.frame = v;
     } else if (a == "--serve") {
       std::stringstream s(v);
       std::string spec;
@@ -315,7 +287,7 @@ Result<Options> parse(int argc, char** argv) {
     } else {
       return makeError(ErrorCode::kInvalidArgument,
                        "unknown option '" + a +
-                           "' (--round-trips, --rounds, --slaves, --cpu, --serve)");
+                           "' (--round-trips, --rounds, --slaves, --cpu, --frame, --serve)");
     }
   }
   if (o.serves.empty()) o.serves.push_back({"serve", ECSIM_BINARY, {}});
@@ -358,15 +330,19 @@ int run(int argc, char** argv) {
   const bool fifo = sched_setscheduler(0, SCHED_FIFO | SCHED_RESET_ON_FORK, &param) == 0;
   if (o.cpu >= 0) pinTo(o.cpu, true);  // the client off the responders' CPU
   fmt::print(
-      "floor_bench: {} round trips per run, {} round(s), 64-byte BRD, client {}; {}; "
+      "floor_bench: {} round trips per run, {} round(s), {}, client {}; {}; "
       "load average at start {}\n",
-      o.roundTrips, o.rounds, fifo ? "SCHED_FIFO" : "normal priority (FIFO refused)",
-      o.cpu >= 0 ? fmt::format("responders and in-process figures on CPU {}, the client off it",
-                               o.cpu)
-                 : std::string("no CPU pinned"),
+      o.roundTrips, o.rounds,
+      o.frame == "brd" ? "64-byte BRD" : "BM_CyclicFrame's frames in turn (LRW, FRMW)",
+      fifo ? "SCHED_FIFO" : "normal priority (FIFO refused)",
+      o.cpu >= 0
+          ? fmt::format("responders and in-process figures on CPU {}, the client off it", o.cpu)
+          : std::string("no CPU pinned"),
       loadAverage());
   std::fflush(stdout);
 
+  std::map<unsigned, bench::Workload> workloads;
+  for (unsigned n : o.slaves) workloads[n] = bench::makeWorkload(o.frame, n);
   // results[responder][slaves] = one Figures per round; "floor" is the floor responder.
   std::map<std::string, std::map<unsigned, std::vector<Figures>>> results;
   for (unsigned round = 0; round < o.rounds && !stop.raised(); ++round) {
@@ -379,7 +355,7 @@ int run(int argc, char** argv) {
         if (stop.raised()) break;
         std::vector<std::string> command;
         if (o.cpu >= 0) command = {"taskset", "-c", std::to_string(o.cpu)};
-        std::uint16_t wkc = 1;
+        client.use(workloads.at(n), who == "floor");
         if (who == "floor") {
           command.insert(command.end(), {ECSIM_FLOOR_RESPONDER, ns->simulatorInterface(), "--rt",
                                          "--qdisc-bypass"});
@@ -389,9 +365,8 @@ int run(int argc, char** argv) {
           command.insert(command.end(), {s.path, "serve", "--iface", ns->simulatorInterface(),
                                          "--slaves", std::to_string(n), "--rt", "--quiet"});
           command.insert(command.end(), s.args.begin(), s.args.end());
-          wkc = static_cast<std::uint16_t>(n);  // BRD: every slave counts once
         }
-        auto f = measureResponder(*ns, client, command, wkc, o.roundTrips, stop);
+        auto f = measureResponder(*ns, client, command, o.roundTrips, stop);
         if (!f.ok()) {
           if (stop.raised()) break;
           fmt::print(stderr, "floor_bench: {} ({} slaves): {}\n", who, n, f.error().message());
@@ -444,13 +419,14 @@ int run(int argc, char** argv) {
   for (const auto& s : o.serves) fmt::print(" {:>14} {:>6}", s.name, "ratio");
   fmt::print("\n");
   if (o.cpu >= 0) pinTo(o.cpu, false);  // where the responders ran
-  const InProcess one = inProcess(1);
+  const auto inProcess = [&](unsigned n) { return bench::measureInProcess(o.frame, n); };
+  const bench::InProcess one = inProcess(1);
   fmt::print("{:>6} {:>13.1f} ns {:>13.1f} ns {:>13.1f} ns   (whole frame, 1 slave)\n", 1,
              one.frameNs, one.coldFrameNs, one.pollNs);
-  std::map<unsigned, InProcess> inside;
+  std::map<unsigned, bench::InProcess> inside;
   for (unsigned n : o.slaves) {
     if (n == 1) continue;
-    const InProcess at = inside[n] = inProcess(n);
+    const bench::InProcess at = inside[n] = inProcess(n);
     const double frame = (at.frameNs - one.frameNs) / (n - 1);
     const double cold = (at.coldFrameNs - one.coldFrameNs) / (n - 1);
     const double poll = (at.pollNs - one.pollNs) / (n - 1);
@@ -468,11 +444,10 @@ int run(int argc, char** argv) {
     const auto [big, atBig] = *inside.rbegin();
     const auto [small, atSmall] = *std::next(inside.rbegin());
     const double frame = (atBig.frameNs - atSmall.frameNs) / (big - small);
-    fmt::print("{:>6} {:>13.1f} ns {:>16} {:>16}", fmt::format("{}-{}", small, big), frame, "",
-               "");
+    fmt::print("{:>6} {:>13.1f} ns {:>16} {:>16}", fmt::format("{}-{}", small, big), frame, "", "");
     for (const auto& s : o.serves) {
-      const double outside = (overhead(s.name, big) - overhead(s.name, small)) * 1000.0 /
-                             (big - small);
+      const double outside =
+          (overhead(s.name, big) - overhead(s.name, small)) * 1000.0 / (big - small);
       fmt::print(" {:>11.1f} ns {:>6.2f}", outside, outside / frame);
     }
     fmt::print("\n");

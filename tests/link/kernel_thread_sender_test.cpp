@@ -57,11 +57,11 @@ class KernelThreadSenderTest : public ::testing::Test {
   int cpu_{-1};
 };
 
-#define ECSIM_OPEN_SENDER(var, ...)                                                      \
-  auto var = open(__VA_ARGS__);                                                          \
-  if (HasFailure()) return;                                                              \
+#define ECSIM_OPEN_SENDER(var, ...)                                                       \
+  auto var = open(__VA_ARGS__);                                                           \
+  if (HasFailure()) return;                                                               \
   ECSIM_REQUIRE_OR_SKIP(var.has_value(), "the kernel refuses io_uring with SQPOLL here"); \
-  do {                                                                                   \
+  do {                                                                                    \
   } while (false)
 
 // Frames leave whole and in the order given, each send done when it returns: the peer has it.

@@ -155,8 +155,9 @@ int runServe(ServeOptions o) {
                              .busyPoll = o.busyPoll,
                              .sendCpu = sendCpu};
     auto raw = RawSocketLink::open(name, options);
-    if (raw.ok() || sendCpu < 0 || (raw.error().code != ErrorCode::kUnsupported &&
-                                    raw.error().code != ErrorCode::kInvalidArgument)) {
+    if (raw.ok() || sendCpu < 0 ||
+        (raw.error().code != ErrorCode::kUnsupported &&
+         raw.error().code != ErrorCode::kInvalidArgument)) {
       return raw;
     }
     fmt::print(stderr, "ecsim serve: note: {}; answers are sent with send(2)\n",
@@ -325,9 +326,10 @@ int runServe(ServeOptions o) {
                redundantLink ? " and, redundant, " + redundantLink->describe() : std::string(),
                o.pcap.empty() ? "" : fmt::format(", capturing to {}", o.pcap));
     if (sendCpu >= 0) {
-      fmt::print("ecsim: busy-polling; answers sent by a kernel thread on CPU {} (io_uring), "
-                 "this process kept off it\n",
-                 sendCpu);
+      fmt::print(
+          "ecsim: busy-polling; answers sent by a kernel thread on CPU {} (io_uring), "
+          "this process kept off it\n",
+          sendCpu);
     }
     std::fflush(stdout);
   }
