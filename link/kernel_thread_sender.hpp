@@ -3,7 +3,7 @@
 // thread polls (IORING_SETUP_SQPOLL), pinned to another CPU: a send is a few stores into
 // memory shared with that thread, which makes the send() for us.
 //
-// Why (docs/timing.md, "Served path"): on a kernel with page-table isolation and no PCID, as
+// Why (docs/served-path.md): on a kernel with page-table isolation and no PCID, as
 // on this project's CI machines, every entry into the kernel empties the TLB, and the next
 // frame through a long line of simulated slaves pays for it: 48 ns per slave after a getppid()
 // against 30 ns without, at 1000 slaves. A busy-polling server (`ecsim serve --busy-poll`)

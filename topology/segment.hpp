@@ -142,7 +142,7 @@ class Segment final : private slavesim::FirmwarePoller {
   // physical ADO) and returns where the next call goes on. On this project's virtual machines
   // a system call leaves the next frame's pass 40-60 % slower at 100-1000 slaves until it has
   // touched every ESC once more; a pass of this before the frame arrives makes up for it
-  // (docs/timing.md, "Served path").
+  // (docs/served-path.md).
   std::size_t prefetchForNextFrame(std::size_t first, std::size_t count) const;
   // Runs every slave's firmware (call after frames and on the device tick).
   void pollSlaves(SimTime now);

@@ -139,7 +139,7 @@ int runServe(ServeOptions o) {
     return 2;
   }
   // --busy-poll: the answers leave through a kernel thread on another CPU, so that the
-  // server's thread never enters the kernel between frames (docs/timing.md, "Served path").
+  // server's thread never enters the kernel between frames (docs/served-path.md).
   cpu_set_t affinityBefore;
   int sendCpu = o.busyPoll ? claimSendCpu(affinityBefore) : -1;
   if (o.busyPoll && sendCpu < 0) {
@@ -315,7 +315,7 @@ int runServe(ServeOptions o) {
   // slow build (AddressSanitizer) left the SII EEPROM interface busy while the master's frames
   // came back to back, and a scan timed out (StudyLatencyVeth, DriveVeth, SOEM v2 simple_ng).
   // Busy-polling looks at a receive ring without a system call, so the wait between frames
-  // can fetch the ESCs ahead for the next one (docs/timing.md, "Served path").
+  // can fetch the ESCs ahead for the next one (docs/served-path.md).
   options.prefetchWhileIdle = o.busyPoll;
   options.malformedObserver = malformedTap;
   topology::NetworkServer server(*served, segment, clock, options);
