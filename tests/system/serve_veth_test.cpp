@@ -164,16 +164,19 @@ TEST_P(ServeVeth, BroadcastReadCountsEverySlave) {
 
 INSTANTIATE_TEST_SUITE_P(Sizes, ServeVeth, ::testing::Values(1u, 10u, 250u));
 
-// Issue 18: `--busy-poll` answers through a kernel thread on another CPU
-// (link/kernel_thread_sender.hpp), says which, and keeps its own thread off that CPU: a
+// Issue 18: `--busy-poll --send-cpu N` answers through a kernel thread on CPU N
+// (link/kernel_thread_sender.hpp), says so, and keeps its own thread off that CPU: a
 // busy-polling thread at real-time priority beside it would starve it.
-TEST(ServeVethBusyPoll, AnswersThroughAKernelThreadOnACpuItLeaves) {
+TEST(ServeVethBusyPoll, SendCpuAnswersThroughAKernelThreadOnACpuItLeaves) {
   ECSIM_REQUIRE_NETWORK();
-  ASSERT_GE(::sysconf(_SC_NPROCESSORS_ONLN), 2) << "CI machines have 2 CPUs";
+  const long cpus = ::sysconf(_SC_NPROCESSORS_ONLN);
+  ASSERT_GE(cpus, 2) << "CI machines have 2 CPUs";
   auto ns = VethNamespace::create();
   ASSERT_TRUE(ns.ok()) << ns.error().message();
   const std::string log = uniqueTempPath("serve_busy.log");
-  ServedNetwork net(*ns, 10, "", log, {"--busy-poll", "--rt"});
+  const int sendCpu = static_cast<int>(cpus) - 1;
+  ServedNetwork net(*ns, 10, "", log,
+                    {"--busy-poll", "--send-cpu", std::to_string(sendCpu), "--rt"});
   ASSERT_TRUE(net.ok());
   ASSERT_TRUE(net.waitReady()) << readText(log);
   for (int i = 0; i < 200; ++i) {
@@ -186,6 +189,7 @@ TEST(ServeVethBusyPoll, AnswersThroughAKernelThreadOnACpuItLeaves) {
   const auto at = out.find(said);
   ASSERT_NE(at, std::string::npos) << out;
   const int cpu = std::atoi(out.c_str() + at + said.size());
+  EXPECT_EQ(cpu, sendCpu);
   // The server's own affinity leaves the sending CPU out.
   cpu_set_t set;
   ASSERT_EQ(::sched_getaffinity(net.child().pid(), sizeof set, &set), 0);

@@ -226,5 +226,19 @@ TEST(EcsimTool, UnknownTopologyFileIsAClearError) {
   EXPECT_NE(out->output.find("/nonexistent/topology.xml"), std::string::npos) << out->output;
 }
 
+// --send-cpu is for a busy-polling server only, and a process pinned to that very CPU cannot
+// leave it: both said before anything is opened.
+TEST(EcsimTool, SendCpuWithoutBusyPollOrOnTheOnlyAllowedCpuIsAClearError) {
+  auto out = runCommand({kEcsim, "serve", "--iface", "lo", "--slaves", "1", "--send-cpu", "0"});
+  ASSERT_TRUE(out.ok());
+  EXPECT_EQ(out->exitCode, 2);
+  EXPECT_NE(out->output.find("--send-cpu needs --busy-poll"), std::string::npos) << out->output;
+  out = runCommand({"taskset", "-c", "0", kEcsim, "serve", "--iface", "lo", "--slaves", "1",
+                    "--busy-poll", "--send-cpu", "0"});
+  ASSERT_TRUE(out.ok());
+  EXPECT_EQ(out->exitCode, 2);
+  EXPECT_NE(out->output.find("may run on no other CPU"), std::string::npos) << out->output;
+}
+
 }  // namespace
 }  // namespace ecsim::testing

@@ -9,10 +9,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -58,6 +56,7 @@ struct ServeOptions {
   bool quiet{false};
   bool realtime{false};
   bool busyPoll{false};
+  int sendCpu{-1};         // --send-cpu; -1: answers sent with send(2)
   bool status{false};      // live table on the terminal
   std::string statusJson;  // status rewritten periodically to this file
   std::string control;     // live-injection socket; empty: /run/ecsim/<interface>.sock
@@ -65,42 +64,26 @@ struct ServeOptions {
 
 namespace {
 
-// The online CPUs (/sys/devices/system/cpu/online: "0-3", "0,2-5").
-std::vector<int> onlineCpus() {
-  std::vector<int> cpus;
-  std::ifstream in("/sys/devices/system/cpu/online");
-  std::string list;
-  std::getline(in, list);
-  std::stringstream items(list);
-  std::string item;
-  while (std::getline(items, item, ',')) {
-    const auto dash = item.find('-');
-    const int first = std::atoi(item.substr(0, dash).c_str());
-    const int last = dash == std::string::npos ? first : std::atoi(item.substr(dash + 1).c_str());
-    for (int c = first; c <= last && c < CPU_SETSIZE; ++c) cpus.push_back(c);
+// --send-cpu: this process leaves `cpu`, where the sending thread polls: the server's
+// busy-polling at real-time priority beside it would hold the answers back. An error when the
+// process may run nowhere else.
+Status leaveCpu(int cpu) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (sched_getaffinity(0, sizeof set, &set) != 0) {
+    return makeError(ErrorCode::kIo, std::string("sched_getaffinity: ") + std::strerror(errno));
   }
-  return cpus;
-}
-
-// --busy-poll: the CPU for the kernel thread that sends the answers
-// (link/kernel_thread_sender.hpp). Never one the server runs on, where its busy-polling at
-// real-time priority would starve that thread: an online CPU outside this process's affinity
-// when there is one (the server was confined, e.g. `taskset -c 1`), else the last CPU of the
-// affinity, which the process then leaves. -1 on a single CPU: the answers go out with
-// send(2). `restore` is the affinity to go back to if the sender cannot be made.
-int claimSendCpu(cpu_set_t& restore) {
-  CPU_ZERO(&restore);
-  if (sched_getaffinity(0, sizeof restore, &restore) != 0) return -1;
-  const std::vector<int> online = onlineCpus();
-  for (int c : online) {
-    if (!CPU_ISSET(c, &restore)) return c;
+  if (cpu >= CPU_SETSIZE || !CPU_ISSET(cpu, &set)) return okStatus();
+  CPU_CLR(cpu, &set);
+  if (CPU_COUNT(&set) == 0) {
+    return makeError(
+        ErrorCode::kInvalidArgument,
+        "--send-cpu " + std::to_string(cpu) + ": this process may run on no other CPU (taskset?)");
   }
-  if (CPU_COUNT(&restore) < 2 || online.empty()) return -1;
-  const int cpu = online.back();
-  cpu_set_t rest = restore;
-  CPU_CLR(cpu, &rest);
-  if (sched_setaffinity(0, sizeof rest, &rest) != 0) return -1;
-  return cpu;
+  if (sched_setaffinity(0, sizeof set, &set) != 0) {
+    return makeError(ErrorCode::kIo, std::string("sched_setaffinity: ") + std::strerror(errno));
+  }
+  return okStatus();
 }
 
 }  // namespace
@@ -110,6 +93,12 @@ int runServe(ServeOptions o) {
           static_cast<int>(!o.veth.empty()) !=
       1) {
     fmt::print(stderr, "ecsim serve: give exactly one of --iface, --veth or --tap\n");
+    return 2;
+  }
+  if (o.sendCpu >= 0 && !o.busyPoll) {
+    fmt::print(stderr,
+               "ecsim serve: --send-cpu needs --busy-poll (a server that sleeps in the kernel for "
+               "every frame gains nothing from sending without it)\n");
     return 2;
   }
   if (o.busyPoll && !o.tap.empty()) {
@@ -138,34 +127,20 @@ int runServe(ServeOptions o) {
     fmt::print(stderr, "ecsim serve: --redundant-iface needs --iface or --veth\n");
     return 2;
   }
-  // --busy-poll: the answers leave through a kernel thread on another CPU, so that the
-  // server's thread never enters the kernel between frames (docs/served-path.md).
-  cpu_set_t affinityBefore;
-  int sendCpu = o.busyPoll ? claimSendCpu(affinityBefore) : -1;
-  if (o.busyPoll && sendCpu < 0) {
-    fmt::print(stderr,
-               "ecsim serve: note: --busy-poll on a single CPU: answers are sent with send(2)\n");
-  }
-  // Opens a raw socket for serving; without the sending thread (and a note) when the kernel
-  // refuses it.
-  auto openServed = [&](const std::string& name) -> Result<RawSocketLink> {
-    RawSocketOptions options{.netns = o.netns,
-                             .promiscuous = true,
-                             .qdiscBypass = true,
-                             .busyPoll = o.busyPoll,
-                             .sendCpu = sendCpu};
-    auto raw = RawSocketLink::open(name, options);
-    if (raw.ok() || sendCpu < 0 ||
-        (raw.error().code != ErrorCode::kUnsupported &&
-         raw.error().code != ErrorCode::kInvalidArgument)) {
-      return raw;
+  // --send-cpu: the answers leave through a kernel thread on that CPU, so that the server's
+  // thread never enters the kernel between frames (docs/served-path.md).
+  if (o.sendCpu >= 0) {
+    if (auto left = leaveCpu(o.sendCpu); !left.ok()) {
+      fmt::print(stderr, "ecsim serve: {}\n", left.error().message());
+      return 2;
     }
-    fmt::print(stderr, "ecsim serve: note: {}; answers are sent with send(2)\n",
-               raw.error().message());
-    sendCpu = -1;
-    (void)sched_setaffinity(0, sizeof affinityBefore, &affinityBefore);
-    options.sendCpu = -1;
-    return RawSocketLink::open(name, options);
+  }
+  auto openServed = [&](const std::string& name) {
+    return RawSocketLink::open(name, RawSocketOptions{.netns = o.netns,
+                                                      .promiscuous = true,
+                                                      .qdiscBypass = true,
+                                                      .busyPoll = o.busyPoll,
+                                                      .sendCpu = o.sendCpu});
   };
   std::unique_ptr<Link> link;
   std::unique_ptr<Link> redundantLink;
@@ -325,11 +300,11 @@ int runServe(ServeOptions o) {
     fmt::print("ecsim: serving {} slave(s) on {}{}{}\n", segment.size(), link->describe(),
                redundantLink ? " and, redundant, " + redundantLink->describe() : std::string(),
                o.pcap.empty() ? "" : fmt::format(", capturing to {}", o.pcap));
-    if (sendCpu >= 0) {
+    if (o.sendCpu >= 0) {
       fmt::print(
           "ecsim: busy-polling; answers sent by a kernel thread on CPU {} (io_uring), "
           "this process kept off it\n",
-          sendCpu);
+          o.sendCpu);
     }
     std::fflush(stdout);
   }
@@ -431,8 +406,14 @@ CommandRunner addServeCommand(CLI::App& app) {
   cmd->add_flag("--rt", opts->realtime, "Run with SCHED_FIFO priority and locked memory");
   cmd->add_flag("--busy-poll", opts->busyPoll,
                 "Wait for frames by polling a receive ring without sleeping, the slaves' state "
-                "fetched ahead meanwhile, the answers sent by a kernel thread on another CPU: "
-                "shorter round trips, two cores kept busy (for dedicated cores)");
+                "fetched ahead meanwhile: shorter round trips, one core kept busy (for a "
+                "dedicated core)");
+  cmd->add_option("--send-cpu", opts->sendCpu,
+                  "With --busy-poll: send the answers through a kernel thread polling on CPU "
+                  "(io_uring), which this process then leaves: no system call between frames. "
+                  "For a CPU of its own: a real-time thread busy there (a polling master) holds "
+                  "the answers back")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--status", opts->status, "Show a live status table (redrawn twice a second)");
   cmd->add_option("--status-json", opts->statusJson,
                   "Rewrite the status to FILE (JSON) twice a second");
