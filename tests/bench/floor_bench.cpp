@@ -10,7 +10,7 @@
 // from outside ((difference at N - difference at 1) / (N - 1), and between the two largest
 // counts) beside the same frames' cost per slave measured in this process (Segment::processFrame
 // with warm caches and with cold ones, and Segment::pollSlaves, the firmware the server runs
-// between frames). A figure, never a pass/fail on timing: the exit status is 1 only when a
+// between frames; measured in every round beside the served runs, the median taken). A figure, never a pass/fail on timing: the exit status is 1 only when a
 // responder did not answer, or answered with a wrong working counter.
 //
 //   floor_bench [--round-trips N] [--rounds R] [--slaves 1,10,60,250,1000] [--cpu C]
@@ -344,6 +344,8 @@ int run(int argc, char** argv) {
   std::map<unsigned, bench::Workload> workloads;
   for (unsigned n : o.slaves) workloads[n] = bench::makeWorkload(o.frame, n);
   // results[responder][slaves] = one Figures per round; "floor" is the floor responder.
+  // inside[slaves] = the in-process figures, one per round (1 slave always among them).
+  std::map<unsigned, std::vector<bench::InProcess>> inside;
   std::map<std::string, std::map<unsigned, std::vector<Figures>>> results;
   for (unsigned round = 0; round < o.rounds && !stop.raised(); ++round) {
     for (unsigned n : o.slaves) {
@@ -378,6 +380,12 @@ int run(int argc, char** argv) {
                    "lost {}\n",
                    round + 1, n, who, f->medianUs, f->p99Us, f->lost);
       }
+      // The same frames in this process, in every round beside the served runs, so that a
+      // slow or fast phase of the host weighs on both figures of a ratio alike.
+      if (o.cpu >= 0) pinTo(o.cpu, false);  // where the responders run
+      if (n == o.slaves.front() && n != 1) inside[1].push_back(bench::measureInProcess(o.frame, 1));
+      inside[n].push_back(bench::measureInProcess(o.frame, n));
+      if (o.cpu >= 0) pinTo(o.cpu, true);
     }
   }
   if (stop.raised()) {
@@ -418,15 +426,28 @@ int run(int argc, char** argv) {
              "in-process poll");
   for (const auto& s : o.serves) fmt::print(" {:>14} {:>6}", s.name, "ratio");
   fmt::print("\n");
-  if (o.cpu >= 0) pinTo(o.cpu, false);  // where the responders ran
-  const auto inProcess = [&](unsigned n) { return bench::measureInProcess(o.frame, n); };
+  // Each in-process figure: the median of the rounds.
+  const auto inProcess = [&](unsigned n) {
+    const auto& rounds = inside[n];
+    auto of = [&](double bench::InProcess::*field) {
+      std::vector<double> v;
+      for (const auto& r : rounds) v.push_back(r.*field);
+      return median(v);
+    };
+    bench::InProcess m;
+    m.frameNs = of(&bench::InProcess::frameNs);
+    m.coldFrameNs = of(&bench::InProcess::coldFrameNs);
+    m.pollNs = of(&bench::InProcess::pollNs);
+    m.frames = of(&bench::InProcess::frames);
+    return m;
+  };
   const bench::InProcess one = inProcess(1);
   fmt::print("{:>6} {:>13.1f} ns {:>13.1f} ns {:>13.1f} ns   (whole frame, 1 slave)\n", 1,
              one.frameNs, one.coldFrameNs, one.pollNs);
-  std::map<unsigned, bench::InProcess> inside;
+  std::map<unsigned, bench::InProcess> atCount;
   for (unsigned n : o.slaves) {
     if (n == 1) continue;
-    const bench::InProcess at = inside[n] = inProcess(n);
+    const bench::InProcess at = atCount[n] = inProcess(n);
     const double frame = (at.frameNs - one.frameNs) / (n - 1);
     const double cold = (at.coldFrameNs - one.coldFrameNs) / (n - 1);
     const double poll = (at.pollNs - one.pollNs) / (n - 1);
@@ -440,9 +461,9 @@ int run(int argc, char** argv) {
   // The same between the two largest counts: whatever of a small frame's processing overlaps
   // with the rest of the round trip (a responder that answers while the client's CPU is still
   // in its send, for one) drops out, where it inflates the 1-slave figure above.
-  if (inside.size() >= 2) {
-    const auto [big, atBig] = *inside.rbegin();
-    const auto [small, atSmall] = *std::next(inside.rbegin());
+  if (atCount.size() >= 2) {
+    const auto [big, atBig] = *atCount.rbegin();
+    const auto [small, atSmall] = *std::next(atCount.rbegin());
     const double frame = (atBig.frameNs - atSmall.frameNs) / (big - small);
     fmt::print("{:>6} {:>13.1f} ns {:>16} {:>16}", fmt::format("{}-{}", small, big), frame, "", "");
     for (const auto& s : o.serves) {
