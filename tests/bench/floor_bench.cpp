@@ -8,9 +8,10 @@
 // `ecsim serve --rt --slaves N`, for each slave count. It prints the median and 99th
 // percentile round trip of each, the difference to the floor, and the cost per slave seen
 // from outside ((difference at N - difference at 1) / (N - 1), and between the two largest
-// counts) beside the same frames' cost per slave measured in this process (Segment::processFrame
-// with warm caches and with cold ones, and Segment::pollSlaves, the firmware the server runs
-// between frames; measured in every round beside the served runs, the median taken). A figure, never a pass/fail on timing: the exit status is 1 only when a
+// counts) beside the same frames' cost per slave measured in this process
+// (Segment::processFrame with warm caches and with cold ones, and Segment::pollSlaves, the
+// firmware the server runs between frames; measured in every round beside the served runs,
+// the median taken). A figure, never a pass/fail on timing: the exit status is 1 only when a
 // responder did not answer, or answered with a wrong working counter.
 //
 //   floor_bench [--round-trips N] [--rounds R] [--slaves 1,10,60,250,1000] [--cpu C]
@@ -95,11 +96,7 @@ struct Figures {
   unsigned lost{0};
 };
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
+using bench::median;
 
 std::string loadAverage() {
   std::ifstream in("/proc/loadavg");
@@ -136,7 +133,12 @@ class Client {
   Result<double> roundTrip() {
     const std::size_t k = next_++ % workload_->cycle.size();
     frame_ = workload_->cycle[k];
-    return exchange(floor_ ? std::uint16_t{1} : workload_->servedWkc[k]);
+    return exchange(expectedWkc(k));
+  }
+
+  // Of cycle frame k: the floor responder adds 1 to every WKC.
+  std::uint16_t expectedWkc(std::size_t k) const {
+    return floor_ ? std::uint16_t{1} : workload_->servedWkc[k];
   }
 
   Result<double> exchange(std::uint16_t wkc) {
@@ -165,7 +167,7 @@ class Client {
     const auto deadline = Clock::now() + limit;
     while (Clock::now() < deadline && !stop.raised()) {
       frame_ = workload_->cycle.front();
-      auto r = exchange(floor_ ? std::uint16_t{1} : workload_->servedWkc.front());
+      auto r = exchange(expectedWkc(0));
       if (!r.ok() && r.error().code == ErrorCode::kInvalidArgument) return r.error();
       if (r.ok() && *r >= 0) return okStatus();
     }

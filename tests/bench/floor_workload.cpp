@@ -94,13 +94,13 @@ std::unique_ptr<topology::Segment> line(unsigned slaves) {
   return seg;
 }
 
+}  // namespace
+
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
   return v[v.size() / 2];
 }
-
-}  // namespace
 
 std::size_t indexOffset() {
   return kEthernetHeaderSize + 2 + 1;

@@ -42,6 +42,9 @@ struct InProcess {
 };
 InProcess measureInProcess(const std::string& kind, unsigned slaves);
 
+// The median of `v` (0 when empty).
+double median(std::vector<double> v);
+
 // Byte offset of the first datagram's index in every frame of a workload.
 std::size_t indexOffset();
 // The working counter of the frame's last datagram (a frame padded to 60 bytes has it before
